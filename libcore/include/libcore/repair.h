@@ -1,0 +1,56 @@
+// Repair of dirty but common input: welding, degenerate/duplicate faces, orientation,
+// non-manifold vertices and edges.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/status.h>
+
+#include <string>
+#include <vector>
+
+namespace quadify::core {
+
+struct RepairOptions {
+  // Weld vertices closer than this, relative to the bounding-box diagonal (binary STL stores
+  // every triangle's corners separately; exporters round differently). 0 = exact duplicates only.
+  double weld_tolerance = 1e-7;
+  // A face whose area is below this, relative to diagonal², is degenerate and dropped.
+  double degenerate_area_tolerance = 1e-14;
+  bool orient_components = true;          // make each component consistently oriented
+  bool split_nonmanifold_vertices = true;  // give each fan of a non-manifold vertex its own copy
+  bool split_nonmanifold_edges = true;     // detach faces beyond a consistent pair on an edge
+};
+
+// Counts of every repair made; reported in the JSON report under "repair".
+struct RepairReport {
+  int input_vertices = 0;
+  int input_faces = 0;                  // polygons as read
+  int polygons_triangulated = 0;        // faces of degree > 3 split into triangles
+  int invalid_faces_removed = 0;        // degree < 3 or repeated vertex ids
+  int welded_vertices = 0;              // vertices merged into another
+  int degenerate_faces_removed = 0;     // zero-area (collinear or collapsed) triangles
+  int duplicate_faces_removed = 0;      // same vertex set as an earlier face
+  int unreferenced_vertices_removed = 0;
+  int faces_reoriented = 0;             // flipped to agree with their component
+  int nonmanifold_edges_split = 0;
+  int nonmanifold_vertices_split = 0;
+  int output_vertices = 0;
+  int output_faces = 0;
+  int n_components = 0;
+  int n_boundary_loops = 0;
+  bool changed() const;
+};
+
+struct RepairResult {
+  Status status;                 // InvalidInput when the mesh cannot be made usable (names why)
+  TriMesh mesh;                  // manifold, consistently oriented, no degenerate faces
+  RepairReport report;
+  std::vector<int> vertex_origin;  // #V of mesh: input vertex id each output vertex came from
+};
+
+// Repairs a polygon mesh into a clean triangle mesh. Never throws on bad geometry; returns
+// InvalidInput with a message naming the problem (e.g. "no faces left after removing 12
+// degenerate faces") when nothing usable remains.
+RepairResult repair_mesh(const PolyMesh& input, const RepairOptions& options = {});
+
+}  // namespace quadify::core

@@ -1,0 +1,45 @@
+// Edge connectivity of a triangle mesh (half-edge convention of mesh.h).
+#pragma once
+
+#include <libcore/mesh.h>
+
+#include <vector>
+
+namespace quadify::core {
+
+struct EdgeTopology {
+  Eigen::MatrixX2i edge_vertex;  // #E×2, edge_vertex(e,0) < edge_vertex(e,1)
+  Eigen::MatrixX3i face_edge;    // #F×3, edge of half-edge 3f+k (from F(f,k) to F(f,(k+1)%3))
+  std::vector<int> twin;         // #F·3, opposite half-edge, -1 on a boundary
+  std::vector<int> edge_halfedge;  // #E, one half-edge of each edge (the one on a face, if boundary)
+  int n_edges() const { return static_cast<int>(edge_vertex.rows()); }
+  bool is_boundary_edge(int e) const { return twin[edge_halfedge[e]] < 0; }
+};
+
+struct TopologyStats {
+  int n_vertices = 0;           // referenced vertices
+  int n_edges = 0;
+  int n_faces = 0;
+  int n_components = 0;         // faces connected through edges
+  int n_boundary_loops = 0;
+  int euler_characteristic = 0;  // V - E + F over referenced vertices
+  int n_nonmanifold_edges = 0;   // edges with more than two incident faces
+  int n_nonmanifold_vertices = 0;  // vertices whose incident faces form more than one fan
+  bool is_manifold() const { return n_nonmanifold_edges == 0 && n_nonmanifold_vertices == 0; }
+  // Genus of a manifold connected oriented mesh: (2 - chi - #boundary loops) / 2, summed over
+  // components; -1 when the mesh is not manifold.
+  int genus = -1;
+};
+
+// Builds edges and twins. Precondition: edge-manifold (≤ 2 faces per edge) and consistently
+// oriented; a third face on an edge or an inconsistently oriented pair throws InvalidInput-style
+// std::invalid_argument naming the edge.
+EdgeTopology build_edge_topology(const TriMesh& mesh);
+
+// Face component ids (#F, 0-based, through shared edges); returns the number of components.
+int face_components(const TriMesh& mesh, const EdgeTopology& topo, std::vector<int>* component);
+
+// Topological statistics of any triangle mesh (also non-manifold ones: counts only).
+TopologyStats topology_stats(const TriMesh& mesh);
+
+}  // namespace quadify::core

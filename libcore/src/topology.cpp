@@ -1,0 +1,156 @@
+#include <libcore/topology.h>
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace quadify::core {
+namespace {
+
+// Key of an undirected edge (a < b).
+inline long long edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
+}
+
+struct DisjointSets {
+  std::vector<int> parent;
+  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) { parent[find(a)] = find(b); }
+};
+
+}  // namespace
+
+EdgeTopology build_edge_topology(const TriMesh& mesh) {
+  const int nf = mesh.n_faces();
+  EdgeTopology topo;
+  topo.face_edge.resize(nf, 3);
+  topo.twin.assign(3 * nf, -1);
+  std::unordered_map<long long, int> edge_of;
+  edge_of.reserve(3 * nf);
+  std::vector<std::array<int, 2>> ev;
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      const int h = 3 * f + k;
+      auto [it, inserted] = edge_of.try_emplace(edge_key(a, b), static_cast<int>(ev.size()));
+      if (inserted) {
+        ev.push_back({std::min(a, b), std::max(a, b)});
+        topo.edge_halfedge.push_back(h);
+      } else {
+        const int e = it->second;
+        const int h0 = topo.edge_halfedge[e];
+        if (topo.twin[h0] >= 0)
+          throw std::invalid_argument("edge (" + std::to_string(a) + ", " + std::to_string(b) +
+                                      ") has more than two faces");
+        if (mesh.F(h0 / 3, h0 % 3) != b)
+          throw std::invalid_argument("faces " + std::to_string(h0 / 3) + " and " + std::to_string(f) +
+                                      " are inconsistently oriented across edge (" + std::to_string(a) +
+                                      ", " + std::to_string(b) + ")");
+        topo.twin[h0] = h;
+        topo.twin[h] = h0;
+      }
+      topo.face_edge(f, k) = it->second;
+    }
+  }
+  topo.edge_vertex.resize(static_cast<int>(ev.size()), 2);
+  for (size_t e = 0; e < ev.size(); ++e) topo.edge_vertex.row(e) << ev[e][0], ev[e][1];
+  return topo;
+}
+
+int face_components(const TriMesh& mesh, const EdgeTopology& topo, std::vector<int>* component) {
+  const int nf = mesh.n_faces();
+  DisjointSets sets(nf);
+  for (int h = 0; h < 3 * nf; ++h)
+    if (topo.twin[h] >= 0) sets.unite(h / 3, topo.twin[h] / 3);
+  std::vector<int> label(nf, -1), root_label(nf, -1);
+  int n = 0;
+  for (int f = 0; f < nf; ++f) {
+    const int r = sets.find(f);
+    if (root_label[r] < 0) root_label[r] = n++;
+    label[f] = root_label[r];
+  }
+  if (component) *component = std::move(label);
+  return n;
+}
+
+TopologyStats topology_stats(const TriMesh& mesh) {
+  TopologyStats s;
+  const int nf = mesh.n_faces(), nv = mesh.n_vertices();
+  s.n_faces = nf;
+  // Undirected edges with their incident half-edges (works for non-manifold input too).
+  std::unordered_map<long long, std::vector<int>> edge_faces;
+  edge_faces.reserve(3 * nf);
+  std::vector<char> used(nv, 0);
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      used[mesh.F(f, k)] = 1;
+      edge_faces[edge_key(mesh.F(f, k), mesh.F(f, (k + 1) % 3))].push_back(3 * f + k);
+    }
+  s.n_vertices = static_cast<int>(std::count(used.begin(), used.end(), 1));
+  s.n_edges = static_cast<int>(edge_faces.size());
+  s.euler_characteristic = s.n_vertices - s.n_edges + s.n_faces;
+
+  DisjointSets face_sets(std::max(nf, 1));
+  DisjointSets corner_sets(std::max(3 * nf, 1));  // corners of one vertex in one fan
+  // Boundary half-edges: next boundary half-edge chains give the loops.
+  std::vector<int> boundary_halfedges;
+  bool oriented = true;
+  for (auto& [key, hs] : edge_faces) {
+    if (hs.size() > 2) ++s.n_nonmanifold_edges;
+    if (hs.size() == 1) boundary_halfedges.push_back(hs[0]);
+    if (hs.size() == 2) {
+      const int h0 = hs[0], h1 = hs[1];
+      face_sets.unite(h0 / 3, h1 / 3);
+      const int a0 = mesh.F(h0 / 3, h0 % 3), a1 = mesh.F(h1 / 3, h1 % 3);
+      if (a0 == a1) oriented = false;
+      // Join the corners of the same vertex on both sides of the edge.
+      const int c0a = h0, c0b = 3 * (h0 / 3) + (h0 % 3 + 1) % 3;
+      const int c1a = h1, c1b = 3 * (h1 / 3) + (h1 % 3 + 1) % 3;
+      auto vert = [&](int c) { return mesh.F(c / 3, c % 3); };
+      for (int ca : {c0a, c0b})
+        for (int cb : {c1a, c1b})
+          if (vert(ca) == vert(cb)) corner_sets.unite(ca, cb);
+    }
+    if (hs.size() > 2)
+      for (size_t i = 1; i < hs.size(); ++i) face_sets.unite(hs[0] / 3, hs[i] / 3);
+  }
+  // Components over faces connected through edges.
+  std::vector<char> is_root(nf, 0);
+  for (int f = 0; f < nf; ++f) is_root[face_sets.find(f)] = 1;
+  s.n_components = static_cast<int>(std::count(is_root.begin(), is_root.end(), 1));
+  // Non-manifold vertices: more than one corner fan.
+  std::vector<int> fans(nv, 0);
+  for (int c = 0; c < 3 * nf; ++c)
+    if (corner_sets.find(c) == c) ++fans[mesh.F(c / 3, c % 3)];
+  for (int v = 0; v < nv; ++v)
+    if (fans[v] > 1) ++s.n_nonmanifold_vertices;
+  // Boundary loops: connected groups of boundary edges (through shared vertices).
+  if (!boundary_halfedges.empty()) {
+    DisjointSets vsets(nv);
+    std::vector<char> on_boundary(nv, 0);
+    for (int h : boundary_halfedges) {
+      const int a = mesh.F(h / 3, h % 3), b = mesh.F(h / 3, (h % 3 + 1) % 3);
+      vsets.unite(a, b);
+      on_boundary[a] = on_boundary[b] = 1;
+    }
+    std::vector<char> root(nv, 0);
+    for (int v = 0; v < nv; ++v)
+      if (on_boundary[v]) root[vsets.find(v)] = 1;
+    s.n_boundary_loops = static_cast<int>(std::count(root.begin(), root.end(), 1));
+  }
+  if (s.is_manifold() && oriented) {
+    // Σ over components of (2 - χ_c - b_c)/2 = (2·#C - χ - b) / 2.
+    const int twice = 2 * s.n_components - s.euler_characteristic - s.n_boundary_loops;
+    s.genus = twice >= 0 && twice % 2 == 0 ? twice / 2 : -1;
+  }
+  return s;
+}
+
+}  // namespace quadify::core
