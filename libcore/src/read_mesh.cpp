@@ -1,0 +1,1 @@
+// Implemented by its helper; see the header.
