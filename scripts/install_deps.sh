@@ -48,6 +48,7 @@ if (( with_test_tools )); then
   if [[ ! -f "$validator" ]]; then
     echo "install_deps: installing npm gltf-validator into .deps/npm" >&2
     mkdir -p "$here/.deps/npm"
-    (cd "$here/.deps/npm" && npm install --silent --no-audit --no-fund --prefix . gltf-validator@2 >/dev/null)
+    # The validator is published only as 2.0.0-dev.* prereleases, which a bare "@2" range excludes.
+    (cd "$here/.deps/npm" && npm install --silent --no-audit --no-fund --prefix . gltf-validator@2.0.0-dev.3.10 >/dev/null)
   fi
 fi
