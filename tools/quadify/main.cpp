@@ -1,0 +1,88 @@
+// quadify: triangle mesh → quad mesh. Subcommands: info, check (param and the end-to-end run
+// arrive with their stages). Exit codes: 0 ok, 2 bad input, 1 internal failure.
+#include "commands.h"
+
+#include <libcore/status.h>
+
+#include <cstdio>
+#include <map>
+#include <new>
+
+#ifdef QUADIFY_WITH_TBB
+#include <tbb/global_control.h>
+#endif
+
+namespace {
+
+constexpr const char* kFooter = R"(Exit codes:
+  0  success
+  2  bad input: the file cannot be read or used, or the options are invalid (one line on stderr
+     names the file and the problem; no output file is written)
+  1  internal failure (a bug or an exhausted resource); no partial output is left behind
+
+Run `quadify <command> --help` for the options of a command.)";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace quadify;
+  CLI::App app{"quadify " QUADIFY_VERSION " — quad remeshing by direct seamless parametrization"};
+  app.footer(kFooter);
+  app.set_version_flag("--version", "quadify " QUADIFY_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();  // common options may follow the subcommand
+
+  cli::CommonOptions common;
+  app.add_option("--json", common.json_path,
+                 "Write a JSON report (inputs, repairs, metrics, per-stage seconds) to this file")
+      ->type_name("FILE");
+  app.add_option("--threads", common.threads, "Worker threads (0 = all cores); results do not depend on it")
+      ->check(CLI::Range(0, 1024))
+      ->type_name("N");
+  app.add_flag("-q,--quiet", common.quiet, "No progress messages on stderr");
+
+  std::map<CLI::App*, cli::CommandRunner> runners;
+  auto add = [&](const char* name, const char* description, auto registrar) {
+    CLI::App* sub = app.add_subcommand(name, description);
+    runners[sub] = registrar(*sub);
+  };
+  add("info", "Mesh statistics and what repair would do to the input", cli::register_info);
+  add("check",
+      "Metrics of a parametrization (triangle OBJ with vt) or of a quad mesh, made by any tool",
+      cli::register_check);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help/version or the error
+    return code == 0 ? cli::kExitOk : cli::kExitBadInput;
+  }
+
+#ifdef QUADIFY_WITH_TBB
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (common.threads > 0)
+    thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                         static_cast<size_t>(common.threads));
+#endif
+
+  try {
+    for (auto& [sub, run] : runners)
+      if (sub->parsed()) return run(common);
+    return cli::kExitBadInput;
+  } catch (const cli::CliError& e) {
+    std::fprintf(stderr, "quadify: %s\n", e.message.c_str());
+    return e.exit_code;
+  } catch (const core::InputError& e) {
+    std::fprintf(stderr, "quadify: %s\n", e.what());
+    return cli::kExitBadInput;
+  } catch (const core::OutputError& e) {
+    std::fprintf(stderr, "quadify: %s\n", e.what());
+    return cli::kExitInternal;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "quadify: out of memory\n");
+    return cli::kExitInternal;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "quadify: internal error: %s\n", e.what());
+    return cli::kExitInternal;
+  }
+}

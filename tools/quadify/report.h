@@ -1,0 +1,76 @@
+// The CLI's shared pieces: the JSON report, stage progress on stderr, exit codes, option structs.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/repair.h>
+#include <libcore/topology.h>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <thread>
+
+namespace quadify::cli {
+
+// Documented exit codes (README, --help).
+constexpr int kExitOk = 0;
+constexpr int kExitInternal = 1;   // a bug or resource failure (bad_alloc, failed write)
+constexpr int kExitBadInput = 2;   // unusable input file or options
+
+struct CommonOptions {
+  std::string json_path;  // --json FILE
+  int threads = 0;        // --threads N (0 = all cores)
+  bool quiet = false;     // --quiet
+};
+
+// A user-facing failure: message already names the file and the problem.
+struct CliError {
+  int exit_code;
+  std::string message;
+};
+
+// Prints "quadify: <stage> ..." on stderr when a stage runs longer than a second, and its duration
+// when it ends; records every stage's seconds for the report.
+class Progress {
+ public:
+  explicit Progress(bool quiet);
+  ~Progress();
+  void begin(const std::string& stage);
+  void end();  // ends the current stage
+  // Optional sub-step text of the current stage (e.g. "batch 3/5"), printed when verbose.
+  void step(const std::string& text);
+  const nlohmann::json& timings() const { return timings_; }
+
+ private:
+  void watch();
+  bool quiet_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::thread watcher_;
+  bool stop_ = false;
+  std::string stage_;
+  std::chrono::steady_clock::time_point stage_start_;
+  bool announced_ = false;
+  nlohmann::json timings_ = nlohmann::json::object();
+};
+
+// Reading + repair, shared by every command that takes a triangle mesh.
+struct LoadedMesh {
+  core::PolyMesh raw;
+  core::RepairResult repaired;
+};
+LoadedMesh load_and_repair(const std::filesystem::path& path, Progress& progress);
+
+nlohmann::json to_json(const core::RepairReport& report);
+nlohmann::json to_json(const core::TopologyStats& stats);
+nlohmann::json input_json(const std::filesystem::path& path, const core::PolyMesh& raw);
+
+// Writes the report atomically to options.json_path if set.
+void write_report(const CommonOptions& options, nlohmann::json report);
+
+}  // namespace quadify::cli
