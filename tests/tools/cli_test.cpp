@@ -1,0 +1,217 @@
+// The CLI as a user meets it: exit codes, one-line errors that name the file, reports, and no
+// partial output on failure.
+#include "test_util.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+using quadify::test::cli_path;
+using quadify::test::data_path;
+using quadify::test::make_temp_dir;
+
+namespace {
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs `quadify <args>` with stdout/stderr captured to files of `dir`.
+Run quadify(const std::string& args, const fs::path& dir) {
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const std::string cmd = "'" + cli_path() + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  const int status = std::system(cmd.c_str());
+  Run r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+// Unit cube, 8 vertices, 12 triangles, outward CCW.
+const char* kCubeTriObj = R"(v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+)";
+
+// The same cube as 6 quads.
+const char* kCubeQuadObj = R"(v 0 0 0
+v 1 0 0
+v 1 1 0
+v 0 1 0
+v 0 0 1
+v 1 0 1
+v 1 1 1
+v 0 1 1
+f 1 4 3 2
+f 5 6 7 8
+f 1 2 6 5
+f 2 3 7 6
+f 3 4 8 7
+f 4 1 5 8
+)";
+
+// A flat 2×1 strip of 4 triangles with UVs equal to the positions (an isometry, no seams).
+const char* kStripUvObj = R"(v 0 0 0
+v 1 0 0
+v 2 0 0
+v 0 1 0
+v 1 1 0
+v 2 1 0
+vt 0 0
+vt 1 0
+vt 2 0
+vt 0 1
+vt 1 1
+vt 2 1
+f 1/1 2/2 5/5
+f 1/1 5/5 4/4
+f 2/2 3/3 6/6
+f 2/2 6/6 5/5
+)";
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (cli_path().empty()) GTEST_SKIP() << "quadify CLI not built";
+    dir_ = make_temp_dir("cli");
+    ASSERT_FALSE(dir_.empty());
+  }
+  void TearDown() override {
+    std::error_code ec;
+    if (!dir_.empty()) fs::remove_all(dir_, ec);
+  }
+  fs::path dir_;
+};
+
+TEST_F(CliTest, HelpListsCommandsAndExitCodes) {
+  const Run r = quadify("--help", dir_);
+  EXPECT_EQ(r.exit_code, 0);
+  for (const char* word : {"info", "check", "--json", "--threads", "--quiet", "Exit codes"})
+    EXPECT_NE(r.out.find(word), std::string::npos) << "help lacks " << word << ":\n" << r.out;
+}
+
+TEST_F(CliTest, VersionPrintsVersion) {
+  const Run r = quadify("--version", dir_);
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.out.find("quadify"), std::string::npos);
+}
+
+TEST_F(CliTest, UnknownOptionIsBadInput) {
+  const Run r = quadify("info --no-such-option x.obj", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+}
+
+TEST_F(CliTest, InfoReportsTopologyAndRepairs) {
+  write_text(dir_ / "cube.obj", kCubeTriObj);
+  const Run r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(j["mesh"]["faces"], 12);
+  EXPECT_EQ(j["mesh"]["genus"], 0);
+  EXPECT_EQ(j["mesh"]["euler_characteristic"], 2);
+  EXPECT_EQ(j["repair"]["welded_vertices"], 0);
+  EXPECT_TRUE(j["timings"].contains("read"));
+}
+
+TEST_F(CliTest, MissingFileIsBadInputNamingTheFileWithoutReport) {
+  const fs::path missing = dir_ / "does_not_exist.obj";
+  const Run r = quadify("info '" + missing.string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("does_not_exist.obj"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one error line expected:\n" << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.json"));
+}
+
+TEST_F(CliTest, TruncatedBinaryStlIsBadInput) {
+  std::string bytes(80, ' ');
+  const unsigned n = 1000;  // announces 1000 triangles, holds none
+  bytes.append(reinterpret_cast<const char*>(&n), 4);
+  write_text(dir_ / "trunc.stl", bytes);
+  const Run r = quadify("info '" + (dir_ / "trunc.stl").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("trunc.stl"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.json"));
+}
+
+TEST_F(CliTest, UnwritableReportIsInternalFailure) {
+  write_text(dir_ / "cube.obj", kCubeTriObj);
+  const Run r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "no/such/dir/r.json").string() + "'", dir_);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("r.json"), std::string::npos) << r.err;
+}
+
+TEST_F(CliTest, CheckQuadCubeAgainstTriangleCube) {
+  write_text(dir_ / "cube.obj", kCubeTriObj);
+  write_text(dir_ / "quads.obj", kCubeQuadObj);
+  const Run r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "cube.obj").string() +
+                            "' --samples 5000 --json '" + (dir_ / "c.json").string() + "'",
+                        dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["kind"], "quad");
+  EXPECT_EQ(j["faces"], 6);
+  EXPECT_EQ(j["non_quads"], 0);
+  EXPECT_EQ(j["irregular_vertices"], 8);
+  EXPECT_EQ(j["flipped_quads"], 0);
+  EXPECT_EQ(j["manifold"], true);
+  EXPECT_EQ(j["genus"], 0);
+  EXPECT_LT(j["hausdorff_sym"].get<double>(), 1e-9);
+  EXPECT_NEAR(j["feature_capture"].get<double>(), 1.0, 1e-9);
+}
+
+TEST_F(CliTest, CheckUvMapOfIsometricStrip) {
+  write_text(dir_ / "strip.obj", kStripUvObj);
+  const Run r = quadify("check '" + (dir_ / "strip.obj").string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["kind"], "uv");
+  EXPECT_EQ(j["flipped"], 0);
+  EXPECT_NEAR(j["tau"].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(j["seam_edges"], 0);
+  EXPECT_EQ(j["cones"], 0);
+  EXPECT_LT(j["gauss_bonnet_error"].get<double>(), 1e-9);
+}
+
+TEST_F(CliTest, CheckWithMissingReferenceIsBadInput) {
+  write_text(dir_ / "quads.obj", kCubeQuadObj);
+  const Run r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "nope.stl").string() + "'", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("nope.stl"), std::string::npos) << r.err;
+}
+
+}  // namespace
