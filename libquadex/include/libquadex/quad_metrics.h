@@ -32,8 +32,11 @@ struct QuadMetrics {
   int euler_characteristic = 0;
   int genus = -1;           // -1 when not manifold or not orientable
   int n_flipped = 0;        // quads with a corner of scaled Jacobian ≤ 0 (or facing against the reference)
-  double sj_min = 0, sj_mean = 0;   // scaled Jacobian over all quad corners
-  double angle_dev_mean = 0, angle_dev_max = 0;  // |corner angle - 90°| in degrees
+  // Scaled Jacobian of the quad corners: minimum over all corners, and mean over quads of each
+  // quad's minimum corner (the peers' definition).
+  double sj_min = 0, sj_mean = 0;
+  // |corner angle - 90°| in degrees over all quad corners, the angle unsigned in [0°, 180°].
+  double angle_dev_mean = 0, angle_dev_max = 0;
   double edge_len_cv = 0;   // coefficient of variation of edge lengths
   double edge_len_mean = 0;
   // Against the reference (only when given), fractions of the reference bbox diagonal.
