@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <exception>
 #include <fstream>
 #include <unistd.h>
 
@@ -24,7 +25,13 @@ fs::path temp_path_for(const fs::path& target) {
 void write_temp(const fs::path& target, const fs::path& tmp, const std::function<void(std::ostream&)>& write) {
   std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw OutputError(target.string() + ": cannot create file (" + std::strerror(errno) + ")");
-  write(out);
+  try {
+    write(out);
+  } catch (const OutputError&) {
+    throw;
+  } catch (const std::exception& e) {  // the header promises OutputError for any failure
+    throw OutputError(target.string() + ": " + e.what());
+  }
   out.flush();
   if (!out) throw OutputError(target.string() + ": write failed (disk full or I/O error)");
   out.close();

@@ -20,7 +20,11 @@ struct SparseSolver::Impl {
   Eigen::Index nnz = 0;
 };
 
-SparseSolver::SparseSolver() : impl_(std::make_unique<Impl>()) {}
+SparseSolver::SparseSolver() : impl_(std::make_unique<Impl>()) {
+#ifdef QUADIFY_WITH_CHOLMOD
+  impl_->solver.cholmod().print = 0;  // failures come back as Status; a library never prints
+#endif
+}
 SparseSolver::~SparseSolver() = default;
 SparseSolver::SparseSolver(SparseSolver&&) noexcept = default;
 SparseSolver& SparseSolver::operator=(SparseSolver&&) noexcept = default;

@@ -10,8 +10,9 @@ namespace quadify::core {
 // 0 collinear. Exact for any finite doubles.
 int orient2d(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c);
 
-// Sign of the orientation of (a, b, c, d) in space: +1 if d is below the plane of (a, b, c)
-// seen counter-clockwise (CGAL::POSITIVE convention), -1 above, 0 coplanar.
+// Sign of the orientation of (a, b, c, d) in space: sign of det[b-a, c-a, d-a] (CGAL::POSITIVE
+// convention): +1 if d lies on the side from which (a, b, c) appear counter-clockwise, -1 on the
+// other side, 0 coplanar.
 int orient3d(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
              const Eigen::Vector3d& d);
 

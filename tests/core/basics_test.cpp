@@ -1,0 +1,323 @@
+// Tests of the small libcore pieces: mesh.h conversions, topology.h, predicates.h,
+// sparse_solver.h, atomic_file.h, status.h.
+#include "test_util.h"
+#include "writer_samples.h"
+
+#include <libcore/atomic_file.h>
+#include <libcore/mesh.h>
+#include <libcore/predicates.h>
+#include <libcore/sparse_solver.h>
+#include <libcore/status.h>
+#include <libcore/topology.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace quadify::core {
+namespace {
+namespace fs = std::filesystem;
+
+// Solver residuals are relative to ‖b‖; a well-conditioned SPD system solves to ~1e-15.
+constexpr double kSolveRelTol = 1e-10;
+
+TriMesh octahedron_tri() { return to_trimesh(test::octahedron()); }
+
+// n×n grid torus: (n·n) vertices, 2n² triangles, genus 1.
+TriMesh grid_torus(int n) {
+  TriMesh mesh;
+  mesh.V.resize(n * n, 3);
+  mesh.F.resize(2 * n * n, 3);
+  auto id = [n](int i, int j) { return ((i + n) % n) * n + (j + n) % n; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double a = 2 * M_PI * i / n, b = 2 * M_PI * j / n;
+      mesh.V.row(id(i, j)) << (2 + std::cos(b)) * std::cos(a), (2 + std::cos(b)) * std::sin(a), std::sin(b);
+      const int f = 2 * (i * n + j);
+      mesh.F.row(f) << id(i, j), id(i + 1, j), id(i + 1, j + 1);
+      mesh.F.row(f + 1) << id(i, j), id(i + 1, j + 1), id(i, j + 1);
+    }
+  return mesh;
+}
+
+// --- mesh.h ---
+
+TEST(MeshTest, ToPolyKeepsTrianglesAndCornerUvs) {
+  UVMesh uv_mesh;
+  uv_mesh.mesh = octahedron_tri();
+  uv_mesh.corner_uv.resize(24, 2);
+  for (int c = 0; c < 24; ++c) uv_mesh.corner_uv.row(c) << c, -c;
+  const PolyMesh poly = to_poly(uv_mesh);
+  ASSERT_EQ(poly.n_faces(), 8);
+  ASSERT_TRUE(poly.has_uv());
+  for (int f = 0; f < 8; ++f) {
+    EXPECT_EQ(poly.degree(f), 3);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_EQ(poly.vertex(f, k), uv_mesh.mesh.F(f, k)) << "face " << f;
+      EXPECT_EQ(poly.uv.row(poly.face_uv[poly.face_corner(f, k)]), uv_mesh.corner_uv.row(3 * f + k));
+    }
+  }
+  EXPECT_FALSE(to_poly(uv_mesh.mesh).has_uv());
+}
+
+TEST(MeshTest, ToTrimeshFanTriangulatesAndSkipsDegenerateFaces) {
+  PolyMesh poly;
+  poly.V.setZero(6, 3);
+  poly.add_face({0, 1, 2, 3});     // quad → 2
+  poly.add_face({0, 1, 2, 3, 4});  // pentagon → 3
+  poly.add_face({4, 5});           // degree 2 → skipped
+  const TriMesh tri = to_trimesh(poly);
+  ASSERT_EQ(tri.n_faces(), 5);
+  EXPECT_EQ(tri.F.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(tri.F.row(1), Eigen::RowVector3i(0, 2, 3));
+  EXPECT_EQ(tri.F.row(4), Eigen::RowVector3i(0, 3, 4));
+  EXPECT_EQ(tri.n_vertices(), 6);
+}
+
+TEST(MeshTest, ToUvmeshCarriesUvsThroughFanTriangulation) {
+  const PolyMesh cube = test::cube_quads(true);
+  const UVMesh uv = to_uvmesh(cube);
+  ASSERT_EQ(uv.mesh.n_faces(), 12);
+  ASSERT_EQ(uv.corner_uv.rows(), 36);
+  for (int t = 0; t < 12; ++t) {
+    const int f = t / 2, ks[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    for (int j = 0; j < 3; ++j) {
+      const int k = ks[t % 2][j];
+      EXPECT_EQ(uv.mesh.F(t, j), cube.vertex(f, k));
+      EXPECT_EQ(uv.corner_uv.row(3 * t + j), cube.uv.row(cube.face_uv[cube.face_corner(f, k)])) << "tri " << t;
+    }
+  }
+  // Without UVs the corner table is zero (documented fallback).
+  EXPECT_TRUE(to_uvmesh(test::cube_quads(false)).corner_uv.isZero());
+}
+
+TEST(MeshTest, AddFaceRejectsMixingFacesWithAndWithoutUvs) {
+  PolyMesh poly;
+  poly.V.setZero(4, 3);
+  poly.uv.setZero(4, 2);
+  poly.add_face({0, 1, 2}, {0, 1, 2});
+  EXPECT_THROW(poly.add_face({0, 2, 3}), InternalError);
+  EXPECT_THROW(poly.add_face({0, 2, 3}, {0, 1}), InternalError);
+}
+
+TEST(MeshTest, BboxDiagonal) {
+  EXPECT_DOUBLE_EQ(bbox_diagonal(test::cube_quads(false).V), std::sqrt(3.0));
+  EXPECT_EQ(bbox_diagonal(Eigen::MatrixX3d()), 0.0);
+}
+
+// --- topology.h ---
+
+TEST(TopologyTest, OctahedronTwinsAreConsistent) {
+  const TriMesh mesh = octahedron_tri();
+  const EdgeTopology topo = build_edge_topology(mesh);
+  ASSERT_EQ(topo.n_edges(), 12);
+  for (int h = 0; h < 24; ++h) {
+    const int t = topo.twin[h];
+    ASSERT_GE(t, 0) << "closed mesh, half-edge " << h;
+    EXPECT_EQ(topo.twin[t], h);
+    // Twin runs the other way.
+    EXPECT_EQ(mesh.F(t / 3, t % 3), mesh.F(h / 3, (h % 3 + 1) % 3));
+    EXPECT_EQ(topo.face_edge(h / 3, h % 3), topo.face_edge(t / 3, t % 3));
+    const int e = topo.face_edge(h / 3, h % 3);
+    EXPECT_LT(topo.edge_vertex(e, 0), topo.edge_vertex(e, 1));
+    EXPECT_FALSE(topo.is_boundary_edge(e));
+  }
+  std::vector<int> comp;
+  EXPECT_EQ(face_components(mesh, topo, &comp), 1);
+  const TopologyStats s = topology_stats(mesh);
+  EXPECT_EQ(s.euler_characteristic, 2);
+  EXPECT_EQ(s.genus, 0);
+  EXPECT_EQ(s.n_boundary_loops, 0);
+  EXPECT_TRUE(s.is_manifold());
+}
+
+TEST(TopologyTest, TorusHasGenusOne) {
+  const TopologyStats s = topology_stats(grid_torus(4));
+  EXPECT_EQ(s.n_vertices, 16);
+  EXPECT_EQ(s.n_edges, 48);
+  EXPECT_EQ(s.euler_characteristic, 0);
+  EXPECT_EQ(s.genus, 1);
+  EXPECT_EQ(s.n_components, 1);
+}
+
+TEST(TopologyTest, DisksComponentsAndBoundaries) {
+  TriMesh mesh;
+  mesh.V.setZero(7, 3);
+  mesh.F.resize(3, 3);
+  mesh.F << 0, 1, 2, 0, 2, 3,  // a square disk
+      4, 5, 6;                 // a separate triangle
+  const EdgeTopology topo = build_edge_topology(mesh);
+  EXPECT_EQ(topo.n_edges(), 8);
+  int n_boundary = 0;
+  for (int e = 0; e < topo.n_edges(); ++e) n_boundary += topo.is_boundary_edge(e);
+  EXPECT_EQ(n_boundary, 7);
+  std::vector<int> comp;
+  EXPECT_EQ(face_components(mesh, topo, &comp), 2);
+  EXPECT_EQ(comp[0], comp[1]);
+  EXPECT_NE(comp[0], comp[2]);
+  const TopologyStats s = topology_stats(mesh);
+  EXPECT_EQ(s.n_boundary_loops, 2);
+  EXPECT_EQ(s.n_components, 2);
+  EXPECT_EQ(s.genus, 0);
+}
+
+TEST(TopologyTest, NonManifoldInputIsCountedOrRejected) {
+  TriMesh fin;  // three triangles on edge (0,1)
+  fin.V.setZero(5, 3);
+  fin.F.resize(3, 3);
+  fin.F << 0, 1, 2, 1, 0, 3, 0, 1, 4;
+  EXPECT_THROW(build_edge_topology(fin), std::invalid_argument);
+  const TopologyStats s = topology_stats(fin);
+  EXPECT_EQ(s.n_nonmanifold_edges, 1);
+  EXPECT_FALSE(s.is_manifold());
+  EXPECT_EQ(s.genus, -1);
+
+  TriMesh bowtie;  // two triangles sharing only vertex 0
+  bowtie.V.setZero(5, 3);
+  bowtie.F.resize(2, 3);
+  bowtie.F << 0, 1, 2, 0, 3, 4;
+  EXPECT_EQ(topology_stats(bowtie).n_nonmanifold_vertices, 1);
+
+  TriMesh flipped;  // two triangles with the same orientation of their shared edge
+  flipped.V.setZero(4, 3);
+  flipped.F.resize(2, 3);
+  flipped.F << 0, 1, 2, 0, 1, 3;
+  EXPECT_THROW(build_edge_topology(flipped), std::invalid_argument);
+}
+
+// --- predicates.h ---
+
+TEST(PredicatesTest, Orient2dSignsAndExactness) {
+  EXPECT_EQ(orient2d({0, 0}, {1, 0}, {0, 1}), 1);
+  EXPECT_EQ(orient2d({0, 0}, {0, 1}, {1, 0}), -1);
+  EXPECT_EQ(orient2d({0, 0}, {1, 1}, {3, 3}), 0);
+  // 3·0.1 rounds up, so c lies exactly above the line y = 3x, although the naive double
+  // determinant 1·c.y - 3·c.x evaluates to exactly 0.
+  const Eigen::Vector2d c(0.1, 0.1 * 3);
+  ASSERT_EQ(1.0 * c.y() - 3.0 * c.x(), 0.0) << "test premise: the naive determinant must evaluate to 0";
+  EXPECT_EQ(orient2d({0, 0}, {1, 3}, c), 1);
+  // One ulp off the line decides the sign.
+  const double up = std::nextafter(24.0, 25.0);
+  EXPECT_EQ(orient2d({0.5, 0.5}, {12, 12}, {24, up}), 1);
+  EXPECT_EQ(orient2d({0.5, 0.5}, {12, 12}, {up, 24}), -1);
+}
+
+TEST(PredicatesTest, Orient3dFollowsTheDocumentedConvention) {
+  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);  // CCW seen from +z
+  EXPECT_EQ(orient3d(a, b, c, {0, 0, 1}), 1) << "on the side where abc is CCW";
+  EXPECT_EQ(orient3d(a, b, c, {0, 0, -1}), -1) << "on the other side";
+  EXPECT_EQ(orient3d(a, b, c, {5, -7, 0}), 0);
+  // Exactly coplanar points with non-representable-looking coordinates.
+  EXPECT_EQ(orient3d({0.1, 0.2, 0.3}, {1.1, 0.2, 0.3}, {0.1, 1.2, 0.3}, {1e8, -3e7, 0.3}), 0);
+  EXPECT_EQ(orient3d(a, b, c, {0.3, 0.3, -std::numeric_limits<double>::denorm_min()}), -1);
+}
+
+TEST(PredicatesTest, Collinear3d) {
+  EXPECT_TRUE(collinear3d({0, 0, 0}, {1, 2, 3}, {2, 4, 6}));
+  EXPECT_FALSE(collinear3d({0, 0, 0}, {1, 2, 3}, {2, 4, std::nextafter(6.0, 7.0)}));
+}
+
+// --- sparse_solver.h ---
+
+Eigen::SparseMatrix<double> path_laplacian_plus_identity(int n, double diag_shift) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (int i = 0; i < n; ++i) {
+    t.emplace_back(i, i, diag_shift + (i > 0) + (i + 1 < n));
+    if (i + 1 < n) {
+      t.emplace_back(i, i + 1, -1.0);
+      t.emplace_back(i + 1, i, -1.0);
+    }
+  }
+  Eigen::SparseMatrix<double> A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  return A;
+}
+
+TEST(SparseSolverTest, SolvesSpdSystemsAndRefactorizes) {
+  const int n = 50;
+  SparseSolver solver;
+  EXPECT_FALSE(solver.factorized());
+  const std::string backend = SparseSolver::backend();
+  EXPECT_TRUE(backend == "cholmod" || backend == "eigen-ldlt") << backend;
+  Eigen::MatrixXd b = Eigen::MatrixXd::Random(n, 3);
+  for (double shift : {1.0, 0.25}) {  // same pattern, new values
+    const Eigen::SparseMatrix<double> A = path_laplacian_plus_identity(n, shift);
+    ASSERT_TRUE(solver.factorize(A).is_ok());
+    ASSERT_TRUE(solver.factorized());
+    const Eigen::MatrixXd x = solver.solve(b);
+    const double rel = (A * x - b).norm() / b.norm();
+    EXPECT_LT(rel, kSolveRelTol) << "shift " << shift << " backend " << backend;
+  }
+}
+
+TEST(SparseSolverTest, ReportsBadInputAsStatus) {
+  SparseSolver solver;
+  Eigen::SparseMatrix<double> rect(3, 4);
+  EXPECT_EQ(solver.analyze(rect).code(), StatusCode::kInvalidInput);
+  EXPECT_THROW((void)solver.solve(Eigen::VectorXd::Ones(3)), InternalError);
+  const Eigen::SparseMatrix<double> negative = -path_laplacian_plus_identity(10, 1.0);
+  const Status s = solver.factorize(negative);
+  EXPECT_EQ(s.code(), StatusCode::kNumericalFailure) << s.to_string();
+  EXPECT_FALSE(solver.factorized());
+}
+
+// --- atomic_file.h ---
+
+TEST(AtomicFileTest, WritesReplacesAndCleansUp) {
+  const fs::path dir = test::make_temp_dir("atomic");
+  ASSERT_FALSE(dir.empty());
+  const fs::path path = dir / "x.txt";
+  write_file_atomically(path, [](std::ostream& out) { out << "one"; });
+  write_file_atomically(path, [](std::ostream& out) { out << "two"; });
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  EXPECT_EQ(s.str(), "two");
+  write_files_atomically({{dir / "a", [](std::ostream& out) { out << "a"; }},
+                          {dir / "b", [](std::ostream& out) { out << "b"; }}});
+  EXPECT_TRUE(fs::exists(dir / "a"));
+  EXPECT_TRUE(fs::exists(dir / "b"));
+  // A throwing callback surfaces as OutputError naming the file; nothing is left behind.
+  try {
+    write_file_atomically(dir / "c", [](std::ostream&) { throw std::runtime_error("callback failed"); });
+    ADD_FAILURE() << "no exception";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("callback failed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find((dir / "c").string()), std::string::npos) << e.what();
+  }
+  size_t n_files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir)) ++n_files;
+  EXPECT_EQ(n_files, 3u) << "x.txt, a, b only";
+  fs::remove_all(dir);
+}
+
+// --- status.h ---
+
+TEST(StatusTest, CodesMessagesAndChecks) {
+  EXPECT_TRUE(Status::ok().is_ok());
+  EXPECT_EQ(Status().to_string(), "ok");
+  const Status s = Status::invalid_input("face 3 is degenerate");
+  EXPECT_FALSE(s.is_ok());
+  EXPECT_EQ(s.code(), StatusCode::kInvalidInput);
+  EXPECT_EQ(s.message(), "face 3 is degenerate");
+  EXPECT_EQ(s.to_string(), "invalid input: face 3 is degenerate");
+  EXPECT_EQ(Status::io_error("x").code(), StatusCode::kIoError);
+  EXPECT_EQ(Status::not_converged("x").code(), StatusCode::kNotConverged);
+  EXPECT_EQ(Status::numerical_failure("x").code(), StatusCode::kNumericalFailure);
+  EXPECT_EQ(Status::internal("x").to_string(), "internal error: x");
+  EXPECT_STREQ(status_code_name(StatusCode::kNotConverged), "not converged");
+  try {
+    QUADIFY_CHECK(1 + 1 == 3, "arithmetic");
+    ADD_FAILURE() << "QUADIFY_CHECK did not throw";
+  } catch (const InternalError& e) {
+    EXPECT_NE(std::string(e.what()).find("1 + 1 == 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("arithmetic"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace quadify::core
