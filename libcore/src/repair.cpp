@@ -1,1 +1,495 @@
-// Implemented by its helper; see the header.
+// repair_mesh: polygon soup → manifold, consistently oriented triangle mesh. Steps, in order:
+// triangulate, drop invalid faces, weld (hash grid), drop collapsed faces, remove zero-area
+// triangles by splitting their neighbour (keeps closed surfaces closed), drop duplicate faces,
+// split non-manifold edges and vertices (one vertex copy per fan), orient components, drop
+// unreferenced vertices, check with build_edge_topology.
+#include <libcore/repair.h>
+
+#include <libcore/predicates.h>
+#include <libcore/topology.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+
+namespace quadify::core {
+namespace {
+
+using Tri = std::array<int, 3>;
+
+inline long long edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
+}
+
+struct DisjointSets {
+  std::vector<int> parent;
+  explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  // The smaller root wins, so results do not depend on the union order's details.
+  void unite(int a, int b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+struct CellKey {
+  long long x, y, z;
+  bool operator==(const CellKey&) const = default;
+};
+struct CellHash {
+  size_t operator()(const CellKey& k) const {
+    return static_cast<size_t>(k.x * 73856093LL ^ k.y * 19349663LL ^ k.z * 83492791LL);
+  }
+};
+
+// Welds vertices within `tol` of an earlier representative (first in index order). Returns the
+// representative of each vertex. O(n) expected: each vertex probes the 27 cells around it.
+std::vector<int> weld_vertices(const Eigen::MatrixX3d& V, double tol) {
+  const int nv = static_cast<int>(V.rows());
+  std::vector<int> rep(nv);
+  // Cells of size tol; exact-duplicate hashing (tol = 0) uses the coordinates' bit patterns.
+  constexpr double kMaxCellIndex = 1e15;  // beyond this, cell indices lose integer precision
+  const double max_abs = V.rows() ? V.cwiseAbs().maxCoeff() : 0.0;
+  const bool use_grid = tol > 0 && max_abs / tol < kMaxCellIndex;
+  std::unordered_map<CellKey, std::vector<int>, CellHash> cells;
+  cells.reserve(nv);
+  for (int v = 0; v < nv; ++v) {
+    rep[v] = v;
+    CellKey key;
+    if (use_grid) {
+      key = {static_cast<long long>(std::floor(V(v, 0) / tol)),
+             static_cast<long long>(std::floor(V(v, 1) / tol)),
+             static_cast<long long>(std::floor(V(v, 2) / tol))};
+      bool found = false;
+      for (int dx = -1; dx <= 1 && !found; ++dx)
+        for (int dy = -1; dy <= 1 && !found; ++dy)
+          for (int dz = -1; dz <= 1 && !found; ++dz) {
+            auto it = cells.find({key.x + dx, key.y + dy, key.z + dz});
+            if (it == cells.end()) continue;
+            for (int r : it->second)
+              if ((V.row(r) - V.row(v)).norm() <= tol) {
+                rep[v] = r;
+                found = true;
+                break;
+              }
+          }
+      if (!found) cells[key].push_back(v);
+    } else {
+      // Exact duplicates: the coordinates themselves are the key (+0.0 and -0.0 are equal).
+      double c[3] = {V(v, 0) + 0.0, V(v, 1) + 0.0, V(v, 2) + 0.0};
+      std::memcpy(&key, c, sizeof(c));
+      auto [it, inserted] = cells.try_emplace(key, std::vector<int>{v});
+      if (!inserted) rep[v] = it->second.front();
+    }
+  }
+  return rep;
+}
+
+bool has_repeat(const Tri& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
+
+class Repairer {
+ public:
+  Repairer(const PolyMesh& input, const RepairOptions& options) : in_(input), opt_(options) {}
+
+  RepairResult run() {
+    RepairResult result;
+    RepairReport& rep = result.report;
+    rep.input_vertices = in_.n_vertices();
+    rep.input_faces = in_.n_faces();
+    V_ = in_.V;
+    origin_.resize(V_.rows());
+    std::iota(origin_.begin(), origin_.end(), 0);
+    for (int v = 0; v < V_.rows(); ++v)
+      if (!V_.row(v).allFinite()) {
+        result.status = Status::invalid_input("vertex " + std::to_string(v) + " is not finite");
+        return result;
+      }
+    triangulate(&rep);
+    diag_ = bbox_diagonal(V_);
+    weld(&rep);
+    remove_zero_area(&rep);
+    remove_duplicates(&rep);
+    if (alive_count() == 0) {
+      result.status = Status::invalid_input(
+          "no faces left after removing " + std::to_string(rep.invalid_faces_removed) +
+          " invalid, " + std::to_string(rep.degenerate_faces_removed) + " degenerate and " +
+          std::to_string(rep.duplicate_faces_removed) + " duplicate faces");
+      return result;
+    }
+    compact_faces();
+    if (opt_.split_nonmanifold_edges || opt_.split_nonmanifold_vertices) split_nonmanifold(&rep);
+    if (opt_.orient_components) {
+      Status s = orient(&rep);
+      if (!s.is_ok()) {
+        result.status = s;
+        return result;
+      }
+    }
+    remove_unreferenced(&rep, &result);
+    try {
+      const EdgeTopology topo = build_edge_topology(result.mesh);
+      rep.n_components = face_components(result.mesh, topo, nullptr);
+      const TopologyStats stats = topology_stats(result.mesh);
+      rep.n_boundary_loops = stats.n_boundary_loops;
+    } catch (const std::invalid_argument& e) {
+      result.status = Status::invalid_input(std::string("mesh is not usable after repair: ") + e.what());
+      return result;
+    }
+    rep.output_vertices = result.mesh.n_vertices();
+    rep.output_faces = result.mesh.n_faces();
+    return result;
+  }
+
+ private:
+  void triangulate(RepairReport* rep) {
+    const int nv = in_.n_vertices();
+    std::vector<int> poly;
+    for (int f = 0; f < in_.n_faces(); ++f) {
+      const int d = in_.degree(f);
+      poly.clear();
+      bool valid = d >= 3;
+      for (int k = 0; k < d && valid; ++k) {
+        const int v = in_.vertex(f, k);
+        valid = v >= 0 && v < nv && std::find(poly.begin(), poly.end(), v) == poly.end();
+        poly.push_back(v);
+      }
+      if (!valid) {
+        ++rep->invalid_faces_removed;
+        continue;
+      }
+      if (d > 3) ++rep->polygons_triangulated;
+      for (int k = 1; k + 1 < d; ++k) tris_.push_back({poly[0], poly[k], poly[k + 1]});
+    }
+    alive_.assign(tris_.size(), 1);
+  }
+
+  void weld(RepairReport* rep) {
+    const double tol = opt_.weld_tolerance * diag_;
+    const std::vector<int> to = weld_vertices(V_, tol);
+    for (int v = 0; v < static_cast<int>(to.size()); ++v) rep->welded_vertices += to[v] != v;
+    for (size_t f = 0; f < tris_.size(); ++f) {
+      for (int& v : tris_[f]) v = to[v];
+      if (has_repeat(tris_[f])) {
+        alive_[f] = 0;
+        ++rep->degenerate_faces_removed;
+      }
+    }
+  }
+
+  bool is_zero_area(const Tri& t) const {
+    const Eigen::Vector3d a = V_.row(t[0]), b = V_.row(t[1]), c = V_.row(t[2]);
+    if (collinear3d(a, b, c)) return true;
+    return 0.5 * (b - a).cross(c - a).norm() < opt_.degenerate_area_tolerance * diag_ * diag_;
+  }
+
+  // Removes each zero-area triangle (a, m, b), m opposite its longest edge (a, b), by splitting
+  // the neighbour across (a, b) at m: the neighbour's edge a-b becomes a-m-b, which matches the
+  // two short edges of the removed triangle, so a closed surface stays closed.
+  void remove_zero_area(RepairReport* rep) {
+    std::unordered_map<long long, std::vector<int>> edge_faces;
+    auto link = [&](int f) {
+      for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+    };
+    auto unlink = [&](int f) {
+      for (int k = 0; k < 3; ++k) {
+        auto& list = edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])];
+        list.erase(std::find(list.begin(), list.end(), f));
+      }
+    };
+    std::deque<int> queue;
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+      if (alive_[f]) {
+        link(f);
+        if (is_zero_area(tris_[f])) queue.push_back(f);
+      }
+    // Each split replaces one triangle by two; bound the work on pathological input.
+    long long budget = 4 * static_cast<long long>(tris_.size()) + 16;
+    while (!queue.empty()) {
+      const int f = queue.front();
+      queue.pop_front();
+      if (!alive_[f] || !is_zero_area(tris_[f])) continue;
+      const Tri t = tris_[f];
+      int k_long = 0;  // longest edge runs t[k_long] → t[k_long+1]
+      double best = -1.0;
+      for (int k = 0; k < 3; ++k) {
+        const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).squaredNorm();
+        if (len > best) best = len, k_long = k;
+      }
+      const int a = t[k_long], b = t[(k_long + 1) % 3], m = t[(k_long + 2) % 3];
+      unlink(f);
+      alive_[f] = 0;
+      ++rep->degenerate_faces_removed;
+      const auto& across = edge_faces[edge_key(a, b)];
+      if (across.size() != 1 || --budget < 0) continue;  // boundary or non-manifold: just drop
+      const int g = across.front();
+      const Tri u = tris_[g];
+      int j = 0;
+      while (!((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))) ++j;
+      const int x = u[j], y = u[(j + 1) % 3], c = u[(j + 2) % 3];
+      if (c == m) {  // the neighbour is the same triangle reversed: both vanish
+        unlink(g);
+        alive_[g] = 0;
+        ++rep->degenerate_faces_removed;
+        continue;
+      }
+      unlink(g);
+      alive_[g] = 0;
+      for (const Tri& n : {Tri{x, m, c}, Tri{m, y, c}}) {
+        tris_.push_back(n);
+        alive_.push_back(1);
+        link(static_cast<int>(tris_.size()) - 1);
+        if (is_zero_area(n)) queue.push_back(static_cast<int>(tris_.size()) - 1);
+      }
+    }
+  }
+
+  void remove_duplicates(RepairReport* rep) {
+    std::unordered_map<long long, std::vector<int>> by_edge;  // smallest edge → faces
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f) {
+      if (!alive_[f]) continue;
+      Tri s = tris_[f];
+      std::sort(s.begin(), s.end());
+      auto& list = by_edge[edge_key(s[0], s[1])];
+      bool dup = false;
+      for (int g : list) {
+        Tri sg = tris_[g];
+        std::sort(sg.begin(), sg.end());
+        if (sg == s) dup = true;
+      }
+      if (dup) {
+        alive_[f] = 0;
+        ++rep->duplicate_faces_removed;
+      } else {
+        list.push_back(f);
+      }
+    }
+  }
+
+  int alive_count() const { return static_cast<int>(std::count(alive_.begin(), alive_.end(), 1)); }
+
+  void compact_faces() {
+    std::vector<Tri> kept;
+    kept.reserve(tris_.size());
+    for (size_t f = 0; f < tris_.size(); ++f)
+      if (alive_[f]) kept.push_back(tris_[f]);
+    tris_ = std::move(kept);
+    alive_.assign(tris_.size(), 1);
+  }
+
+  int add_vertex_copy(int v) {
+    const int id = static_cast<int>(V_.rows());
+    V_.conservativeResize(id + 1, 3);
+    V_.row(id) = V_.row(v);
+    origin_.push_back(origin_[v]);
+    return id;
+  }
+
+  // Faces of a non-manifold edge beyond one pair are cut off the edge; then every vertex gets one
+  // copy per fan (faces around it connected through uncut edges). A second round gives cut faces
+  // private corners on edges still shared by more than two faces (fans joined elsewhere).
+  void split_nonmanifold(RepairReport* rep) {
+    const int nf = static_cast<int>(tris_.size());
+    for (int round = 0; round < 2; ++round) {
+      std::unordered_map<long long, std::vector<int>> edge_faces;
+      for (int f = 0; f < nf; ++f)
+        for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+      DisjointSets corners(3 * nf);
+      std::vector<long long> keys;
+      keys.reserve(edge_faces.size());
+      for (const auto& [key, faces] : edge_faces) keys.push_back(key);
+      std::sort(keys.begin(), keys.end());  // deterministic order
+      for (long long key : keys) {
+        const std::vector<int>& faces = edge_faces[key];
+        const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffff);
+        int f0 = faces[0], f1 = -1;
+        if (faces.size() > 2) {
+          if (!opt_.split_nonmanifold_edges) continue;
+          if (round == 0) ++rep->nonmanifold_edges_split;
+          // Keep the first face and the first face traversing the edge the other way.
+          const bool f0_ab = runs(tris_[f0], a, b);
+          for (size_t i = 1; i < faces.size() && f1 < 0; ++i)
+            if (runs(tris_[faces[i]], a, b) != f0_ab) f1 = faces[i];
+          if (f1 < 0) f1 = faces[1];
+          if (round == 1) {
+            for (int g : faces)
+              if (g != f0 && g != f1)
+                for (int& v : tris_[g])
+                  if (v == a || v == b) v = add_vertex_copy(v);
+          }
+        } else if (faces.size() == 2) {
+          f1 = faces[1];
+        }
+        if (f1 < 0) continue;
+        for (int v : {a, b}) corners.unite(3 * f0 + corner_of(tris_[f0], v), 3 * f1 + corner_of(tris_[f1], v));
+      }
+      if (round == 1) {
+        // Cut corners changed: recompute fans from scratch.
+        DisjointSets fresh(3 * nf);
+        std::unordered_map<long long, std::vector<int>> ef;
+        for (int f = 0; f < nf; ++f)
+          for (int k = 0; k < 3; ++k) ef[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+        for (const auto& [key, faces] : ef) {
+          if (faces.size() != 2) continue;
+          const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffff);
+          for (int v : {a, b})
+            fresh.unite(3 * faces[0] + corner_of(tris_[faces[0]], v), 3 * faces[1] + corner_of(tris_[faces[1]], v));
+        }
+        corners = fresh;
+      }
+      // One vertex copy per extra fan.
+      std::unordered_map<int, int> first_root;  // vertex → root of the fan keeping the id
+      std::unordered_map<long long, int> copy_of;  // (vertex, root) → new vertex id
+      std::vector<char> counted(V_.rows(), 0);
+      for (int c = 0; c < 3 * nf; ++c) {
+        const int v = tris_[c / 3][c % 3];
+        const int root = corners.find(c);
+        auto [it, inserted] = first_root.try_emplace(v, root);
+        if (inserted || it->second == root) continue;
+        const long long key = (static_cast<long long>(v) << 32) | static_cast<unsigned>(root);
+        auto [cit, new_copy] = copy_of.try_emplace(key, -1);
+        if (new_copy) {
+          cit->second = add_vertex_copy(v);
+          if (round == 0 && !counted[v]) {
+            counted[v] = 1;
+            ++rep->nonmanifold_vertices_split;
+          }
+        }
+        tris_[c / 3][c % 3] = cit->second;
+      }
+      if (!still_nonmanifold_edges()) break;
+    }
+  }
+
+  bool still_nonmanifold_edges() const {
+    std::unordered_map<long long, int> count;
+    for (const Tri& t : tris_)
+      for (int k = 0; k < 3; ++k)
+        if (++count[edge_key(t[k], t[(k + 1) % 3])] > 2) return true;
+    return false;
+  }
+
+  static bool runs(const Tri& t, int a, int b) {
+    for (int k = 0; k < 3; ++k)
+      if (t[k] == a && t[(k + 1) % 3] == b) return true;
+    return false;
+  }
+  static int corner_of(const Tri& t, int v) { return t[0] == v ? 0 : (t[1] == v ? 1 : 2); }
+
+  // Makes every component consistently oriented (BFS over manifold edges), each keeping the
+  // orientation of the majority of its faces, then outward for closed components with volume.
+  Status orient(RepairReport* rep) {
+    const int nf = static_cast<int>(tris_.size());
+    std::unordered_map<long long, std::vector<int>> edge_faces;
+    for (int f = 0; f < nf; ++f)
+      for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+    std::vector<int> flip(nf, -1);  // -1 unvisited, 0 keep, 1 flip
+    int component = 0;
+    for (int seed = 0; seed < nf; ++seed) {
+      if (flip[seed] >= 0) continue;
+      std::vector<int> members{seed};
+      flip[seed] = 0;
+      bool closed = true;
+      for (size_t i = 0; i < members.size(); ++i) {
+        const int f = members[i];
+        for (int k = 0; k < 3; ++k) {
+          const int a = tris_[f][k], b = tris_[f][(k + 1) % 3];
+          const auto& faces = edge_faces[edge_key(a, b)];
+          if (faces.size() != 2) {
+            closed = false;
+            continue;
+          }
+          const int g = faces[0] == f ? faces[1] : faces[0];
+          // f traverses a→b (after its own flip); g must traverse b→a after its flip.
+          const bool f_ab = (flip[f] == 0);
+          const bool g_ab = runs(tris_[g], a, b);
+          const int want = (g_ab == f_ab) ? 1 : 0;
+          if (flip[g] < 0) {
+            flip[g] = want;
+            members.push_back(g);
+          } else if (flip[g] != want) {
+            return Status::invalid_input("component " + std::to_string(component) + " (containing face " +
+                                         std::to_string(seed) + ") is not orientable");
+          }
+        }
+      }
+      long long n_flip = 0;
+      for (int f : members) n_flip += flip[f];
+      bool invert = 2 * n_flip > static_cast<long long>(members.size());
+      if (closed) {
+        double volume = 0.0;
+        for (int f : members) {
+          Tri t = tris_[f];
+          if (flip[f] != invert) std::swap(t[1], t[2]);
+          volume += Eigen::Vector3d(V_.row(t[0])).dot(Eigen::Vector3d(V_.row(t[1])).cross(Eigen::Vector3d(V_.row(t[2]))));
+        }
+        // Below this (relative to diag³) a closed component encloses no volume worth trusting.
+        constexpr double kVolumeTolerance = 1e-12;
+        if (volume < -kVolumeTolerance * diag_ * diag_ * diag_) invert = !invert;
+      }
+      for (int f : members)
+        if (flip[f] != static_cast<int>(invert)) {
+          std::swap(tris_[f][1], tris_[f][2]);
+          ++rep->faces_reoriented;
+        }
+      ++component;
+    }
+    return Status::ok();
+  }
+
+  void remove_unreferenced(RepairReport* rep, RepairResult* result) {
+    std::vector<int> new_id(V_.rows(), -1);
+    int n = 0;
+    for (const Tri& t : tris_)
+      for (int v : t)
+        if (new_id[v] < 0) new_id[v] = n++;
+    // Keep the input order of vertices (new_id by first use would reorder): renumber by id.
+    n = 0;
+    for (int v = 0; v < V_.rows(); ++v)
+      if (new_id[v] >= 0) new_id[v] = n++;
+    // Copies made for splits are not "unreferenced input vertices"; count only input ids.
+    for (int v = 0; v < in_.n_vertices(); ++v) rep->unreferenced_vertices_removed += new_id[v] < 0;
+    rep->unreferenced_vertices_removed -= rep->welded_vertices;
+    result->mesh.V.resize(n, 3);
+    result->vertex_origin.resize(n);
+    for (int v = 0; v < V_.rows(); ++v)
+      if (new_id[v] >= 0) {
+        result->mesh.V.row(new_id[v]) = V_.row(v);
+        result->vertex_origin[new_id[v]] = origin_[v];
+      }
+    result->mesh.F.resize(static_cast<int>(tris_.size()), 3);
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+      for (int k = 0; k < 3; ++k) result->mesh.F(f, k) = new_id[tris_[f][k]];
+  }
+
+  const PolyMesh& in_;
+  const RepairOptions& opt_;
+  Eigen::MatrixX3d V_;
+  std::vector<int> origin_;
+  std::vector<Tri> tris_;
+  std::vector<char> alive_;
+  double diag_ = 0.0;
+};
+
+}  // namespace
+
+bool RepairReport::changed() const {
+  return polygons_triangulated || invalid_faces_removed || welded_vertices ||
+         degenerate_faces_removed || duplicate_faces_removed || unreferenced_vertices_removed ||
+         faces_reoriented || nonmanifold_edges_split || nonmanifold_vertices_split;
+}
+
+RepairResult repair_mesh(const PolyMesh& input, const RepairOptions& options) {
+  return Repairer(input, options).run();
+}
+
+}  // namespace quadify::core
