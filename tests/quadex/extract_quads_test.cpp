@@ -1,0 +1,360 @@
+// Tests of quad extraction on integer-seamless maps constructed in code: planar grids (with and
+// without a rotated seam), a cube with 8 cones, a flat torus, failure modes and a speed check.
+#include <libquadex/extract_quads.h>
+
+#include <libcore/topology.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace quadify::quadex {
+namespace {
+
+using core::UVMesh;
+
+// Combinatorial summary of a polygon mesh.
+struct PolyCheck {
+  int n_used_vertices = 0;
+  int n_edges = 0;
+  int n_boundary_edges = 0;
+  int n_bad_edges = 0;  // a directed edge used twice (non-manifold or inconsistent orientation)
+  int euler = 0;
+  std::map<int, int> degrees;   // face degree → count
+  std::map<int, int> valences;  // vertex valence (distinct neighbours) → count, used vertices
+};
+
+PolyCheck check_poly(const core::PolyMesh& m) {
+  PolyCheck c;
+  std::map<std::pair<int, int>, int> directed;
+  std::vector<std::set<int>> nbrs(m.n_vertices());
+  for (int f = 0; f < m.n_faces(); ++f) {
+    ++c.degrees[m.degree(f)];
+    for (int k = 0; k < m.degree(f); ++k) {
+      const int a = m.vertex(f, k), b = m.vertex(f, (k + 1) % m.degree(f));
+      ++directed[{a, b}];
+      nbrs[a].insert(b);
+      nbrs[b].insert(a);
+    }
+  }
+  std::set<std::pair<int, int>> undirected;
+  for (const auto& [e, n] : directed) {
+    if (n > 1) ++c.n_bad_edges;
+    undirected.insert({std::min(e.first, e.second), std::max(e.first, e.second)});
+    if (!directed.count({e.second, e.first})) ++c.n_boundary_edges;
+  }
+  c.n_edges = static_cast<int>(undirected.size());
+  for (const auto& n : nbrs)
+    if (!n.empty()) {
+      ++c.n_used_vertices;
+      ++c.valences[static_cast<int>(n.size())];
+    }
+  c.euler = c.n_used_vertices - c.n_edges + m.n_faces();
+  return c;
+}
+
+// Every output face's UVs must be a unit square, counter-clockwise, in one integer chart.
+int count_bad_uv_faces(const core::PolyMesh& m) {
+  int bad = 0;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    if (m.degree(f) != 4) continue;
+    bool ok = true;
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector2d a = m.uv.row(m.face_uv[m.face_corner(f, k)]);
+      const Eigen::Vector2d b = m.uv.row(m.face_uv[m.face_corner(f, (k + 1) % 4)]);
+      const Eigen::Vector2d c = m.uv.row(m.face_uv[m.face_corner(f, (k + 2) % 4)]);
+      const Eigen::Vector2d e0 = b - a, e1 = c - b;
+      ok = ok && std::abs(e0.norm() - 1) == 0 && e0.x() * e1.y() - e0.y() * e1.x() == 1;
+    }
+    bad += !ok;
+  }
+  return bad;
+}
+
+// Triangulated planar grid of (n+1)² vertices over [0,side]², with jittered interior vertices
+// (every other one) and pseudo-random diagonals; position (x,y,0), UV = scale·(x,y).
+UVMesh planar_grid(int n, double side, double scale, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  UVMesh m;
+  m.mesh.V.resize((n + 1) * (n + 1), 3);
+  const double h = side / n;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      double x = side * i / n, y = side * j / n;
+      if (i > 0 && i < n && j > 0 && j < n && (i + j) % 2 == 1) {
+        x += jitter(rng) * h;
+        y += jitter(rng) * h;
+      }
+      m.mesh.V.row(j * (n + 1) + i) << x, y, 0.0;
+    }
+  std::vector<std::array<int, 3>> tris;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const int a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+      if (rng() % 2) {
+        tris.push_back({a, b, c});
+        tris.push_back({a, c, d});
+      } else {
+        tris.push_back({a, b, d});
+        tris.push_back({b, c, d});
+      }
+    }
+  m.mesh.F.resize(static_cast<int>(tris.size()), 3);
+  m.corner_uv.resize(3 * static_cast<int>(tris.size()), 2);
+  for (size_t f = 0; f < tris.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      m.mesh.F(f, k) = tris[f][k];
+      m.corner_uv.row(3 * f + k) = scale * m.mesh.V.row(tris[f][k]).head<2>();
+    }
+  return m;
+}
+
+// Applies uv ↦ R_90^r uv + t to the UVs of every face whose centroid has x < x_cut.
+void add_seam(UVMesh& m, double x_cut, int r, Eigen::Vector2d t) {
+  for (int f = 0; f < m.mesh.n_faces(); ++f) {
+    const double cx = (m.mesh.V(m.mesh.F(f, 0), 0) + m.mesh.V(m.mesh.F(f, 1), 0) + m.mesh.V(m.mesh.F(f, 2), 0)) / 3;
+    if (cx >= x_cut) continue;
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector2d p = m.corner_uv.row(3 * f + k);
+      for (int i = 0; i < r; ++i) p = Eigen::Vector2d(-p.y(), p.x());
+      m.corner_uv.row(3 * f + k) = p + t;
+    }
+  }
+}
+
+// Unit cube, each face an m×m grid of squares (alternating diagonals), UV per face = n·(s,t)
+// plus an integer offset: transitions are rotations by k·90° plus integer shifts, 8 cones.
+UVMesh cube(int m, int n) {
+  const Eigen::Vector3d O[6] = {{0, 0, 1}, {0, 0, 0}, {1, 0, 0}, {0, 0, 0}, {0, 1, 0}, {0, 0, 0}};
+  const Eigen::Vector3d U[6] = {{1, 0, 0}, {0, 1, 0}, {0, 1, 0}, {0, 0, 1}, {0, 0, 1}, {1, 0, 0}};
+  const Eigen::Vector3d W[6] = {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}, {0, 1, 0}, {1, 0, 0}, {0, 0, 1}};
+  std::map<std::array<long, 3>, int> index;
+  std::vector<Eigen::Vector3d> verts;
+  std::vector<std::array<int, 3>> tris;
+  std::vector<std::array<Eigen::Vector2d, 3>> uvs;
+  auto vid = [&](const Eigen::Vector3d& p) {
+    const std::array<long, 3> key{std::lround(p.x() * m), std::lround(p.y() * m), std::lround(p.z() * m)};
+    auto [it, inserted] = index.try_emplace(key, static_cast<int>(verts.size()));
+    if (inserted) verts.push_back(p);
+    return it->second;
+  };
+  for (int s = 0; s < 6; ++s) {
+    const Eigen::Vector2d offset(10.0 * s, -3.0 * s);
+    auto corner = [&](int i, int j) {
+      const double a = double(i) / m, b = double(j) / m;
+      return std::pair<int, Eigen::Vector2d>(vid(O[s] + a * U[s] + b * W[s]), Eigen::Vector2d(n * a, n * b) + offset);
+    };
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        const auto a = corner(i, j), b = corner(i + 1, j), c = corner(i + 1, j + 1), d = corner(i, j + 1);
+        if ((i + j) % 2) {
+          tris.push_back({a.first, b.first, c.first}), uvs.push_back({a.second, b.second, c.second});
+          tris.push_back({a.first, c.first, d.first}), uvs.push_back({a.second, c.second, d.second});
+        } else {
+          tris.push_back({a.first, b.first, d.first}), uvs.push_back({a.second, b.second, d.second});
+          tris.push_back({b.first, c.first, d.first}), uvs.push_back({b.second, c.second, d.second});
+        }
+      }
+  }
+  UVMesh out;
+  out.mesh.V.resize(static_cast<int>(verts.size()), 3);
+  for (size_t i = 0; i < verts.size(); ++i) out.mesh.V.row(i) = verts[i];
+  out.mesh.F.resize(static_cast<int>(tris.size()), 3);
+  out.corner_uv.resize(3 * static_cast<int>(tris.size()), 2);
+  for (size_t f = 0; f < tris.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      out.mesh.F(f, k) = tris[f][k];
+      out.corner_uv.row(3 * f + k) = uvs[f][k];
+    }
+  return out;
+}
+
+// Torus from an a×b periodic grid; UV = (i·pu/a, j·pv/b) unwrapped, so faces across the wrap
+// carry translation transitions (pu, 0) / (0, pv).
+UVMesh torus(int a, int b, double pu, double pv) {
+  UVMesh m;
+  m.mesh.V.resize(a * b, 3);
+  for (int j = 0; j < b; ++j)
+    for (int i = 0; i < a; ++i) {
+      const double th = 2 * M_PI * i / a, ph = 2 * M_PI * j / b;
+      m.mesh.V.row(j * a + i) << (3 + std::cos(ph)) * std::cos(th), (3 + std::cos(ph)) * std::sin(th),
+          std::sin(ph);
+    }
+  m.mesh.F.resize(2 * a * b, 3);
+  m.corner_uv.resize(6 * a * b, 2);
+  int f = 0;
+  auto put = [&](std::array<std::pair<int, int>, 3> c) {
+    for (int k = 0; k < 3; ++k) {
+      const auto [i, j] = c[k];
+      m.mesh.F(f, k) = (j % b) * a + (i % a);
+      m.corner_uv.row(3 * f + k) << i * pu / a, j * pv / b;
+    }
+    ++f;
+  };
+  for (int j = 0; j < b; ++j)
+    for (int i = 0; i < a; ++i) {
+      if ((i * 7 + j * 3) % 5 < 2) {
+        put({{{i, j}, {i + 1, j}, {i + 1, j + 1}}});
+        put({{{i, j}, {i + 1, j + 1}, {i, j + 1}}});
+      } else {
+        put({{{i, j}, {i + 1, j}, {i, j + 1}}});
+        put({{{i + 1, j}, {i + 1, j + 1}, {i, j + 1}}});
+      }
+    }
+  return m;
+}
+
+void expect_all_quads(const ExtractResult& r, int n_quads, const std::string& name) {
+  ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+  EXPECT_EQ(r.quads.n_faces(), n_quads) << name;
+  EXPECT_EQ(r.stats.n_non_quads, 0) << name;
+  EXPECT_EQ(r.stats.n_dropped_faces, 0) << name;
+  EXPECT_EQ(count_bad_uv_faces(r.quads), 0) << name << ": faces whose UVs are not unit CCW squares";
+}
+
+// Quad vertex positions of a planar map with UV = scale·(x,y) must be the integer points / scale.
+void expect_planar_lattice(const core::PolyMesh& q, int side, double scale, const std::string& name) {
+  const int n = static_cast<int>(std::lround(side * scale));
+  ASSERT_EQ(q.n_vertices(), (n + 1) * (n + 1)) << name;
+  std::set<std::pair<long, long>> seen;
+  double max_err = 0;
+  for (int i = 0; i < q.n_vertices(); ++i) {
+    const double u = q.V(i, 0) * scale, v = q.V(i, 1) * scale;
+    max_err = std::max({max_err, std::abs(u - std::round(u)), std::abs(v - std::round(v)), std::abs(q.V(i, 2))});
+    seen.insert({std::lround(u), std::lround(v)});
+  }
+  EXPECT_LT(max_err, 1e-9) << name << ": quad vertices off the lattice";
+  EXPECT_EQ(static_cast<int>(seen.size()), (n + 1) * (n + 1)) << name << ": duplicated lattice points";
+}
+
+TEST(ExtractQuads, PlanarIrregularGrid) {
+  for (const double scale : {1.0, 2.0, 2.5}) {
+    const std::string name = "planar scale " + std::to_string(scale);
+    const UVMesh map = planar_grid(6, 4.0, scale, 7);
+    const ExtractResult r = extract_quads(map);
+    const int n = static_cast<int>(std::lround(4 * scale));
+    expect_all_quads(r, n * n, name);
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.n_boundary_edges, 4 * n) << name;
+    EXPECT_EQ(c.valences[2], 4) << name << ": corners";
+    EXPECT_EQ(c.valences[4], (n - 1) * (n - 1)) << name << ": interior vertices";
+    EXPECT_GT(r.stats.n_grid_points_on_vertices, 0) << name;
+    expect_planar_lattice(r.quads, 4, scale, name);
+    const core::TopologyStats t = core::topology_stats(core::to_trimesh(r.quads));
+    EXPECT_TRUE(t.is_manifold()) << name;
+    EXPECT_EQ(t.n_boundary_loops, 1) << name;
+  }
+}
+
+TEST(ExtractQuads, PlanarGridWithRotatedSeam) {
+  for (int r = 1; r < 4; ++r) {
+    const std::string name = "seam rotation " + std::to_string(90 * r);
+    UVMesh map = planar_grid(6, 4.0, 2.0, 11);
+    add_seam(map, 2.1, r, Eigen::Vector2d(7, -3));
+    const ExtractResult res = extract_quads(map);
+    expect_all_quads(res, 64, name);
+    EXPECT_GT(res.stats.n_seam_edges, 0) << name;
+    PolyCheck c = check_poly(res.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.valences[4], 49) << name;
+    expect_planar_lattice(res.quads, 4, 2.0, name);
+  }
+}
+
+TEST(ExtractQuads, CubeHasEightValenceThreeVertices) {
+  for (const auto& [m, n] : std::vector<std::pair<int, int>>{{3, 2}, {3, 3}, {2, 5}, {4, 1}}) {
+    const std::string name = "cube m=" + std::to_string(m) + " n=" + std::to_string(n);
+    const ExtractResult r = extract_quads(cube(m, n));
+    expect_all_quads(r, 6 * n * n, name);
+    EXPECT_EQ(r.stats.n_cones, 8) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.n_boundary_edges, 0) << name;
+    EXPECT_EQ(c.euler, 2) << name;
+    EXPECT_EQ(c.valences[3], 8) << name;
+    EXPECT_EQ(c.valences[4], 6 * n * n - 6) << name;
+    EXPECT_EQ(c.n_used_vertices, 6 * n * n + 2) << name;
+    const core::TopologyStats t = core::topology_stats(core::to_trimesh(r.quads));
+    EXPECT_TRUE(t.is_manifold()) << name;
+    EXPECT_EQ(t.genus, 0) << name;
+  }
+}
+
+TEST(ExtractQuads, FlatTorusIsRegular) {
+  const ExtractResult r = extract_quads(torus(7, 5, 6.0, 4.0));
+  expect_all_quads(r, 24, "torus");
+  PolyCheck c = check_poly(r.quads);
+  EXPECT_EQ(c.n_bad_edges, 0);
+  EXPECT_EQ(c.n_boundary_edges, 0);
+  EXPECT_EQ(c.euler, 0);
+  EXPECT_EQ(c.valences[4], 24) << "every vertex must have valence 4";
+  EXPECT_EQ(r.stats.n_cones, 0);
+}
+
+TEST(ExtractQuads, RejectsNonSeamlessMap) {
+  UVMesh map = planar_grid(6, 4.0, 2.0, 3);
+  add_seam(map, 2.1, 1, Eigen::Vector2d(7.3, -3));
+  const ExtractResult r = extract_quads(map);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+  EXPECT_NE(r.status.message().find("not integer-seamless"), std::string::npos) << r.status.message();
+  EXPECT_NE(r.status.message().find("residual"), std::string::npos) << r.status.message();
+  EXPECT_EQ(r.quads.n_faces(), 0);
+
+  const ExtractResult t = extract_quads(torus(7, 5, 6.3, 4.0));
+  EXPECT_EQ(t.status.code(), core::StatusCode::kInvalidInput) << t.status.to_string();
+}
+
+TEST(ExtractQuads, RejectsFlippedTriangle) {
+  UVMesh map = planar_grid(6, 4.0, 2.0, 5);
+  const int f = 17;
+  const Eigen::Vector2d tmp = map.corner_uv.row(3 * f);
+  map.corner_uv.row(3 * f) = map.corner_uv.row(3 * f + 1);
+  map.corner_uv.row(3 * f + 1) = tmp;
+  const ExtractResult r = extract_quads(map);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+  EXPECT_NE(r.status.message().find("face 17 is flipped"), std::string::npos) << r.status.message();
+}
+
+TEST(ExtractQuads, RejectsConeOffTheLattice) {
+  UVMesh map = cube(2, 2);
+  map.corner_uv.array() += 0.5;  // shifts every chart: rotations then need half-integer shifts
+  const ExtractResult r = extract_quads(map);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+}
+
+TEST(ExtractQuads, RejectsBadSizes) {
+  UVMesh map = planar_grid(2, 1.0, 1.0, 1);
+  map.corner_uv.conservativeResize(5, 2);
+  const ExtractResult r = extract_quads(map);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+}
+
+TEST(ExtractQuads, LargeTorusSpeed) {
+  // 250×200 grid → 100K triangles, 200×100 = 20K quads.
+  const UVMesh map = torus(250, 200, 200.0, 100.0);
+  const ExtractResult r = extract_quads(map);
+  expect_all_quads(r, 20000, "large torus");
+  PolyCheck c = check_poly(r.quads);
+  EXPECT_EQ(c.euler, 0);
+  EXPECT_EQ(c.valences[4], 20000);
+  std::printf("[ stats    ] 100K-triangle torus: %d quads, %d vertices (%d on vertices, %d on edges, "
+              "%d in faces), %.3f s\n",
+              r.stats.n_faces, r.stats.n_vertices, r.stats.n_grid_points_on_vertices,
+              r.stats.n_grid_points_on_edges, r.stats.n_grid_points_in_faces, r.stats.seconds);
+#if !defined(__SANITIZE_ADDRESS__)
+  EXPECT_LT(r.stats.seconds, 5.0) << "target: ≤ 5 s for 100K triangles";
+#endif
+}
+
+}  // namespace
+}  // namespace quadify::quadex
