@@ -61,8 +61,9 @@ std::vector<int> weld_vertices(const Eigen::MatrixX3d& V, double tol) {
   constexpr double kMaxCellIndex = 1e15;  // beyond this, cell indices lose integer precision
   const double max_abs = V.rows() ? V.cwiseAbs().maxCoeff() : 0.0;
   const bool use_grid = tol > 0 && max_abs / tol < kMaxCellIndex;
-  std::unordered_map<CellKey, std::vector<int>, CellHash> cells;
-  cells.reserve(nv);
+  std::unordered_map<CellKey, int, CellHash> head;  // cell → last representative inserted
+  std::vector<int> next(nv, -1);                     // chain of representatives in a cell
+  head.reserve(nv);
   for (int v = 0; v < nv; ++v) {
     rep[v] = v;
     CellKey key;
@@ -70,30 +71,68 @@ std::vector<int> weld_vertices(const Eigen::MatrixX3d& V, double tol) {
       key = {static_cast<long long>(std::floor(V(v, 0) / tol)),
              static_cast<long long>(std::floor(V(v, 1) / tol)),
              static_cast<long long>(std::floor(V(v, 2) / tol))};
-      bool found = false;
-      for (int dx = -1; dx <= 1 && !found; ++dx)
-        for (int dy = -1; dy <= 1 && !found; ++dy)
-          for (int dz = -1; dz <= 1 && !found; ++dz) {
-            auto it = cells.find({key.x + dx, key.y + dy, key.z + dz});
-            if (it == cells.end()) continue;
-            for (int r : it->second)
-              if ((V.row(r) - V.row(v)).norm() <= tol) {
-                rep[v] = r;
-                found = true;
-                break;
-              }
+      int best = -1;  // smallest representative id within tol: independent of probe order
+      for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dz = -1; dz <= 1; ++dz) {
+            auto it = head.find({key.x + dx, key.y + dy, key.z + dz});
+            if (it == head.end()) continue;
+            for (int r = it->second; r >= 0; r = next[r])
+              if ((best < 0 || r < best) && (V.row(r) - V.row(v)).norm() <= tol) best = r;
           }
-      if (!found) cells[key].push_back(v);
+      if (best >= 0) {
+        rep[v] = best;
+      } else {
+        auto [it, inserted] = head.try_emplace(key, v);
+        if (!inserted) next[v] = it->second, it->second = v;
+      }
     } else {
       // Exact duplicates: the coordinates themselves are the key (+0.0 and -0.0 are equal).
       double c[3] = {V(v, 0) + 0.0, V(v, 1) + 0.0, V(v, 2) + 0.0};
       std::memcpy(&key, c, sizeof(c));
-      auto [it, inserted] = cells.try_emplace(key, std::vector<int>{v});
-      if (!inserted) rep[v] = it->second.front();
+      auto [it, inserted] = head.try_emplace(key, v);
+      if (!inserted) rep[v] = it->second;
     }
   }
   return rep;
 }
+
+// Faces around each undirected edge, as a sorted (edge key, face) list: much faster than a hash
+// map of vectors at 10⁵ faces, and iteration order is deterministic.
+class EdgeIndex {
+ public:
+  explicit EdgeIndex(const std::vector<Tri>& tris) {
+    entries_.reserve(3 * tris.size());
+    for (int f = 0; f < static_cast<int>(tris.size()); ++f)
+      for (int k = 0; k < 3; ++k) entries_.push_back({edge_key(tris[f][k], tris[f][(k + 1) % 3]), f});
+    std::sort(entries_.begin(), entries_.end());
+  }
+  // Calls fn(key, first, last) for each edge, with [first, last) its (key, face) entries.
+  template <class Fn>
+  void for_each_edge(Fn fn) const {
+    for (size_t i = 0; i < entries_.size();) {
+      size_t j = i;
+      while (j < entries_.size() && entries_[j].first == entries_[i].first) ++j;
+      fn(entries_[i].first, entries_.begin() + i, entries_.begin() + j);
+      i = j;
+    }
+  }
+  // The faces of one edge, in increasing id order.
+  std::vector<int> faces(long long key) const {
+    std::vector<int> out;
+    auto it = std::lower_bound(entries_.begin(), entries_.end(), std::make_pair(key, -1));
+    for (; it != entries_.end() && it->first == key; ++it) out.push_back(it->second);
+    return out;
+  }
+  bool max_faces_per_edge_exceeds(int n) const {
+    bool exceeds = false;
+    for_each_edge([&](long long, auto first, auto last) { exceeds |= last - first > n; });
+    return exceeds;
+  }
+
+ private:
+  std::vector<std::pair<long long, int>> entries_;
+};
 
 bool has_repeat(const Tri& t) { return t[0] == t[1] || t[1] == t[2] || t[0] == t[2]; }
 
@@ -208,10 +247,10 @@ class Repairer {
     };
     std::deque<int> queue;
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
-      if (alive_[f]) {
-        link(f);
-        if (is_zero_area(tris_[f])) queue.push_back(f);
-      }
+      if (alive_[f] && is_zero_area(tris_[f])) queue.push_back(f);
+    if (queue.empty()) return;
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+      if (alive_[f]) link(f);
     // Each split replaces one triangle by two; bound the work on pathological input.
     long long budget = 4 * static_cast<long long>(tris_.size()) + 16;
     while (!queue.empty()) {
@@ -254,25 +293,19 @@ class Repairer {
   }
 
   void remove_duplicates(RepairReport* rep) {
-    std::unordered_map<long long, std::vector<int>> by_edge;  // smallest edge → faces
+    std::vector<std::pair<Tri, int>> sorted;  // (sorted vertex ids, face)
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f) {
       if (!alive_[f]) continue;
-      Tri s = tris_[f];
-      std::sort(s.begin(), s.end());
-      auto& list = by_edge[edge_key(s[0], s[1])];
-      bool dup = false;
-      for (int g : list) {
-        Tri sg = tris_[g];
-        std::sort(sg.begin(), sg.end());
-        if (sg == s) dup = true;
-      }
-      if (dup) {
-        alive_[f] = 0;
-        ++rep->duplicate_faces_removed;
-      } else {
-        list.push_back(f);
-      }
+      Tri t = tris_[f];
+      std::sort(t.begin(), t.end());
+      sorted.push_back({t, f});
     }
+    std::sort(sorted.begin(), sorted.end());
+    for (size_t i = 1; i < sorted.size(); ++i)
+      if (sorted[i].first == sorted[i - 1].first) {  // keep the lowest face id of each set
+        alive_[sorted[i].second] = 0;
+        ++rep->duplicate_faces_removed;
+      }
   }
 
   int alive_count() const { return static_cast<int>(std::count(alive_.begin(), alive_.end(), 1)); }
@@ -300,82 +333,70 @@ class Repairer {
   void split_nonmanifold(RepairReport* rep) {
     const int nf = static_cast<int>(tris_.size());
     for (int round = 0; round < 2; ++round) {
-      std::unordered_map<long long, std::vector<int>> edge_faces;
-      for (int f = 0; f < nf; ++f)
-        for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+      const EdgeIndex edges(tris_);
       DisjointSets corners(3 * nf);
-      std::vector<long long> keys;
-      keys.reserve(edge_faces.size());
-      for (const auto& [key, faces] : edge_faces) keys.push_back(key);
-      std::sort(keys.begin(), keys.end());  // deterministic order
-      for (long long key : keys) {
-        const std::vector<int>& faces = edge_faces[key];
+      std::vector<std::array<int, 2>> cut;  // (face, edge key index) to detach in round 1
+      edges.for_each_edge([&](long long key, auto first, auto last) {
         const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffff);
-        int f0 = faces[0], f1 = -1;
-        if (faces.size() > 2) {
-          if (!opt_.split_nonmanifold_edges) continue;
+        const long long n = last - first;
+        int f0 = first->second, f1 = -1;
+        if (n > 2) {
+          if (!opt_.split_nonmanifold_edges) return;
           if (round == 0) ++rep->nonmanifold_edges_split;
           // Keep the first face and the first face traversing the edge the other way.
           const bool f0_ab = runs(tris_[f0], a, b);
-          for (size_t i = 1; i < faces.size() && f1 < 0; ++i)
-            if (runs(tris_[faces[i]], a, b) != f0_ab) f1 = faces[i];
-          if (f1 < 0) f1 = faces[1];
-          if (round == 1) {
-            for (int g : faces)
-              if (g != f0 && g != f1)
-                for (int& v : tris_[g])
+          for (auto it = first + 1; it != last && f1 < 0; ++it)
+            if (runs(tris_[it->second], a, b) != f0_ab) f1 = it->second;
+          if (f1 < 0) f1 = (first + 1)->second;
+          if (round == 1)  // fans joined elsewhere: give the extra faces private corners
+            for (auto it = first; it != last; ++it)
+              if (it->second != f0 && it->second != f1)
+                for (int& v : tris_[it->second])
                   if (v == a || v == b) v = add_vertex_copy(v);
-          }
-        } else if (faces.size() == 2) {
-          f1 = faces[1];
+        } else if (n == 2) {
+          f1 = (first + 1)->second;
         }
-        if (f1 < 0) continue;
-        for (int v : {a, b}) corners.unite(3 * f0 + corner_of(tris_[f0], v), 3 * f1 + corner_of(tris_[f1], v));
-      }
+        if (f1 < 0 || round == 1) return;
+        for (int v : {a, b})
+          corners.unite(3 * f0 + corner_of(tris_[f0], v), 3 * f1 + corner_of(tris_[f1], v));
+      });
       if (round == 1) {
-        // Cut corners changed: recompute fans from scratch.
-        DisjointSets fresh(3 * nf);
-        std::unordered_map<long long, std::vector<int>> ef;
-        for (int f = 0; f < nf; ++f)
-          for (int k = 0; k < 3; ++k) ef[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
-        for (const auto& [key, faces] : ef) {
-          if (faces.size() != 2) continue;
+        // Corners changed: recompute the fans from the edges that now have exactly two faces.
+        const EdgeIndex after(tris_);
+        after.for_each_edge([&](long long key, auto first, auto last) {
+          if (last - first != 2) return;
           const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffff);
+          const int f0 = first->second, f1 = (first + 1)->second;
           for (int v : {a, b})
-            fresh.unite(3 * faces[0] + corner_of(tris_[faces[0]], v), 3 * faces[1] + corner_of(tris_[faces[1]], v));
-        }
-        corners = fresh;
+            corners.unite(3 * f0 + corner_of(tris_[f0], v), 3 * f1 + corner_of(tris_[f1], v));
+        });
       }
-      // One vertex copy per extra fan.
-      std::unordered_map<int, int> first_root;  // vertex → root of the fan keeping the id
-      std::unordered_map<long long, int> copy_of;  // (vertex, root) → new vertex id
+      // One vertex copy per extra fan, in corner order (deterministic).
+      std::vector<int> first_root(V_.rows(), -1);  // vertex → root of the fan keeping the id
+      std::unordered_map<long long, int> copy_of;   // (vertex, root) → new vertex id
       std::vector<char> counted(V_.rows(), 0);
       for (int c = 0; c < 3 * nf; ++c) {
         const int v = tris_[c / 3][c % 3];
         const int root = corners.find(c);
-        auto [it, inserted] = first_root.try_emplace(v, root);
-        if (inserted || it->second == root) continue;
+        if (v < static_cast<int>(first_root.size())) {
+          if (first_root[v] < 0) first_root[v] = root;
+          if (first_root[v] == root) continue;
+        } else {
+          continue;  // a private corner made in this round
+        }
         const long long key = (static_cast<long long>(v) << 32) | static_cast<unsigned>(root);
-        auto [cit, new_copy] = copy_of.try_emplace(key, -1);
+        auto [it, new_copy] = copy_of.try_emplace(key, -1);
         if (new_copy) {
-          cit->second = add_vertex_copy(v);
+          it->second = add_vertex_copy(v);
           if (round == 0 && !counted[v]) {
             counted[v] = 1;
             ++rep->nonmanifold_vertices_split;
           }
         }
-        tris_[c / 3][c % 3] = cit->second;
+        tris_[c / 3][c % 3] = it->second;
       }
-      if (!still_nonmanifold_edges()) break;
+      if (!EdgeIndex(tris_).max_faces_per_edge_exceeds(2)) break;
     }
-  }
-
-  bool still_nonmanifold_edges() const {
-    std::unordered_map<long long, int> count;
-    for (const Tri& t : tris_)
-      for (int k = 0; k < 3; ++k)
-        if (++count[edge_key(t[k], t[(k + 1) % 3])] > 2) return true;
-    return false;
   }
 
   static bool runs(const Tri& t, int a, int b) {
@@ -389,9 +410,7 @@ class Repairer {
   // orientation of the majority of its faces, then outward for closed components with volume.
   Status orient(RepairReport* rep) {
     const int nf = static_cast<int>(tris_.size());
-    std::unordered_map<long long, std::vector<int>> edge_faces;
-    for (int f = 0; f < nf; ++f)
-      for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+    const EdgeIndex edges(tris_);
     std::vector<int> flip(nf, -1);  // -1 unvisited, 0 keep, 1 flip
     int component = 0;
     for (int seed = 0; seed < nf; ++seed) {
@@ -403,7 +422,7 @@ class Repairer {
         const int f = members[i];
         for (int k = 0; k < 3; ++k) {
           const int a = tris_[f][k], b = tris_[f][(k + 1) % 3];
-          const auto& faces = edge_faces[edge_key(a, b)];
+          const std::vector<int> faces = edges.faces(edge_key(a, b));
           if (faces.size() != 2) {
             closed = false;
             continue;
