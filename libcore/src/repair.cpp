@@ -335,7 +335,7 @@ class Repairer {
     for (int round = 0; round < 2; ++round) {
       const EdgeIndex edges(tris_);
       DisjointSets corners(3 * nf);
-      std::vector<std::array<int, 2>> cut;  // (face, edge key index) to detach in round 1
+      std::vector<char> on_cut_edge(V_.rows(), 0);  // endpoints of edges with > 2 faces
       edges.for_each_edge([&](long long key, auto first, auto last) {
         const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffff);
         const long long n = last - first;
@@ -343,6 +343,7 @@ class Repairer {
         if (n > 2) {
           if (!opt_.split_nonmanifold_edges) return;
           if (round == 0) ++rep->nonmanifold_edges_split;
+          on_cut_edge[a] = on_cut_edge[b] = 1;
           // Keep the first face and the first face traversing the edge the other way.
           const bool f0_ab = runs(tris_[f0], a, b);
           for (auto it = first + 1; it != last && f1 < 0; ++it)
@@ -388,7 +389,8 @@ class Repairer {
         auto [it, new_copy] = copy_of.try_emplace(key, -1);
         if (new_copy) {
           it->second = add_vertex_copy(v);
-          if (round == 0 && !counted[v]) {
+          // Copies at the ends of cut edges are part of the edge split, not vertex splits.
+          if (round == 0 && !counted[v] && !on_cut_edge[v]) {
             counted[v] = 1;
             ++rep->nonmanifold_vertices_split;
           }
