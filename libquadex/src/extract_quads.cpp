@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <vector>
 
@@ -470,14 +471,17 @@ class Extractor {
       incident_charts(grid_[g], charts);
       for (const auto& [f, p] : charts)
         for (int d = 0; d < 4; ++d)
-          if (contains(f, p, rot_dir(d, 1), d)) slots_.push_back({static_cast<int>(g), f, d, p});
+          if (contains(f, p, d, rot_dir(d, 1))) slots_.push_back({static_cast<int>(g), f, d, p});
       slot_begin_[g + 1] = static_cast<int>(slots_.size());
     }
   }
 
-  // Face around integer point p of face f (location loc) containing p + ε·kDir[a] + ε²·kDir[b],
-  // and the transform from f's chart to it; {-1, ·} when that point is outside the mesh.
-  std::pair<int, Transform> locate_near(int f, IVec p, const Location& loc, int a, int b) const {
+  // Walking clockwise around the element of integer point p of face f (location loc), starting
+  // with f: the first face containing p + ε·kDir[a] + ε²·kDir[b] and the transform from f's
+  // chart to it; {-1, ·} when the walk reaches the boundary first. Clockwise only: around a
+  // cone of angle > 2π the same chart direction occurs twice, and the wanted copy is the one
+  // less than π/2 clockwise of the start.
+  std::pair<int, Transform> locate_cw(int f, IVec p, const Location& loc, int a, int b) const {
     if (contains(f, p, a, b)) return {f, Transform{}};
     if (loc.where == Where::kEdge) {
       const int h = 3 * f + loc.k;
@@ -489,16 +493,7 @@ class Extractor {
     }
     if (loc.where != Where::kVertex) return {-1, {}};
     const int c0 = 3 * f + loc.k;
-    // Counter-clockwise, then (for a boundary vertex) clockwise around the vertex.
     Transform acc;
-    for (int c = c0;;) {
-      const int next = ccw_corner(c);
-      if (next < 0 || next == c0) break;
-      acc = compose(trans_[ccw_halfedge(c)], acc);
-      if (contains(next / 3, acc.apply(p), rot_dir(a, acc.r), rot_dir(b, acc.r))) return {next / 3, acc};
-      c = next;
-    }
-    acc = Transform{};
     for (int c = c0;;) {
       const int next = cw_corner(c);
       if (next < 0 || next == c0) break;
@@ -509,23 +504,92 @@ class Extractor {
     return {-1, {}};
   }
 
-  // Traces the iso-line of every slot to the next grid point and finds the next half-edge of
-  // its face (turn left there).
+  // Outgoing slot of grid point g with start face `face` and direction `dir`, or -1.
+  int find_slot(int g, int face, int dir) const {
+    for (int n = slot_begin_[g]; n < slot_begin_[g + 1]; ++n)
+      if (slots_[n].face == face && slots_[n].dir == dir) return n;
+    return -1;
+  }
+
+  // The counter-clockwise-most slot of grid point g starting in face `face` (its slot directions
+  // there are consecutive, spanning less than 2π), or -1.
+  int ccw_most_slot(int g, int face) const {
+    int mask = 0;
+    for (int n = slot_begin_[g]; n < slot_begin_[g + 1]; ++n)
+      if (slots_[n].face == face) mask |= 1 << slots_[n].dir;
+    for (int d = 0; d < 4; ++d)
+      if ((mask >> d & 1) && !(mask >> rot_dir(d, 1) & 1)) return find_slot(g, face, d);
+    return -1;
+  }
+
+  int add_halfedge(int vertex, int face, const Eigen::Vector2d& uv) {
+    he_vertex_.push_back(vertex);
+    he_face_.push_back(face);
+    he_uv_.push_back(uv);
+    he_next_.push_back(-1);
+    he_to_next_.push_back(Transform{});
+    return static_cast<int>(he_vertex_.size()) - 1;
+  }
+
+  // An event on a boundary half-edge: the crossing of a (left-perturbed) iso-line
+  // {x[axis] = value + σε}, or a grid point exactly on the edge. Events are the boundary
+  // vertices of the quad mesh between the triangle-mesh vertices.
+  struct BoundaryEvent {
+    bool is_line;
+    int axis, value, sigma;  // line: coordinate axis (0 = u, 1 = v), integer value, offset sign
+    IVec p;                  // point
+    int vertex;              // output vertex id
+  };
+
+  // Is event x before event y walking along the boundary half-edge h? Exact.
+  bool event_before(int h, const BoundaryEvent& x, const BoundaryEvent& y) const {
+    const Eigen::Vector2d& a = uv_[h];
+    const Eigen::Vector2d& b = uv_[3 * (h / 3) + (h % 3 + 1) % 3];
+    const int su = sign(b.x(), a.x()), sv = sign(b.y(), a.y());
+    const int s_axis[2] = {su, sv};
+    auto coord = [](IVec p, int axis) { return axis == 0 ? p.x : p.y; };
+    if (!x.is_line && !y.is_line) {
+      const int axis = su != 0 ? 0 : 1;
+      return s_axis[axis] * (coord(y.p, axis) - coord(x.p, axis)) > 0;
+    }
+    if (x.is_line && !y.is_line) {  // line before point ⟺ the point is past the line
+      const int diff = coord(y.p, x.axis) - x.value;
+      return s_axis[x.axis] * (diff != 0 ? (diff > 0 ? 1 : -1) : -x.sigma) > 0;
+    }
+    if (!x.is_line && y.is_line) return !event_before(h, y, x);
+    if (x.axis == y.axis) {
+      const int diff = x.value != y.value ? (x.value < y.value ? -1 : 1) : (x.sigma < y.sigma ? -1 : 1);
+      return s_axis[x.axis] * diff < 0;
+    }
+    // Lines of both families: compare through their common integer point P.
+    const BoundaryEvent& lu = x.axis == 0 ? x : y;
+    const BoundaryEvent& lv = x.axis == 0 ? y : x;
+    int o = core::orient2d(a, b, Eigen::Vector2d(lu.value, lv.value));
+    if (o == 0) o = -lu.sigma * sv + lv.sigma * su;  // degenerate: the offsets decide
+    const bool u_first = su * sv * o > 0;
+    return (x.axis == 0) == u_first;
+  }
+
+  // Traces the iso-line of every slot to the next grid point (or to the boundary) and links
+  // every quad half-edge to the next one of its face (turn left at its end).
   core::Status trace_all() {
     const int n_slots = static_cast<int>(slots_.size());
-    he_next_.assign(n_slots, -1);
-    he_to_next_.assign(n_slots, Transform{});
+    for (int s = 0; s < n_slots; ++s) add_halfedge(slots_[s].grid, slots_[s].face, to_vec(slots_[s].p));
+    boundary_events_.clear();
+    n_out_vertices_ = static_cast<int>(grid_.size());
     const int max_steps = 2 * nf_ + 8;  // a trace never visits a face twice on a valid map
+    struct Dangling { int slot, exit_halfedge, event_vertex; Transform acc; };
+    std::vector<Dangling> dangling;
     for (int s = 0; s < n_slots; ++s) {
       int f = slots_[s].face, d = slots_[s].dir;
       IVec p = slots_[s].p, q = p + kDir[d];
       Transform acc;
-      bool reached = false;
-      for (int step = 0; step < max_steps; ++step) {
-        if (contains(f, q, rot_dir(d, 1), rot_dir(d, 2))) {
-          reached = true;
-          break;
-        }
+      int exit_halfedge = -1;
+      for (int step = 0;; ++step) {
+        if (step == max_steps)
+          return core::Status::internal("extract_quads: iso-line trace from grid point " +
+                                        std::to_string(slots_[s].grid) + " does not terminate");
+        if (contains(f, q, rot_dir(d, 2), rot_dir(d, 1))) break;
         int exit = -1;
         for (int k = 0; k < 3 && exit < 0; ++k)
           if (line_side(uv(f, k), p, d) < 0 && line_side(uv(f, (k + 1) % 3), p, d) > 0) exit = k;
@@ -534,7 +598,10 @@ class Extractor {
                                         std::to_string(slots_[s].grid) + " lost in face " +
                                         std::to_string(f));
         const int h = 3 * f + exit;
-        if (twin_[h] < 0) break;  // the iso-line leaves the mesh through the boundary
+        if (twin_[h] < 0) {
+          exit_halfedge = h;
+          break;
+        }
         const Transform& t = trans_[h];
         p = t.apply(p);
         q = t.apply(q);
@@ -542,8 +609,23 @@ class Extractor {
         acc = compose(t, acc);
         f = twin_[h] / 3;
       }
-      if (!reached) {
-        ++res_.stats.n_dangling_halfedges;
+      if (exit_halfedge >= 0) {
+        // The iso-line leaves the mesh: a new boundary vertex where it crosses the edge.
+        const int axis = (d & 1) ? 0 : 1;  // ±u lines are v = const and vice versa
+        const int value = axis == 0 ? p.x : p.y;
+        const int sigma = (d == 0 || d == 3) ? 1 : -1;  // side of the left offset along the axis
+        BoundaryEvent ev{true, axis, value, sigma, IVec{}, n_out_vertices_++};
+        boundary_events_[exit_halfedge].push_back(ev);
+        const Eigen::Vector2d& a = uv_[exit_halfedge];
+        const Eigen::Vector2d& b = uv_[3 * f + (exit_halfedge % 3 + 1) % 3];
+        const double t = std::clamp((value - a[axis]) / (b[axis] - a[axis]), 0.0, 1.0);
+        const Eigen::Vector2d x = a + t * (b - a);
+        extra_uv_.push_back(x);
+        const auto& F = map_.mesh.F;
+        extra_pos_.push_back((1 - t) * map_.mesh.V.row(F(f, exit_halfedge % 3)).transpose() +
+                             t * map_.mesh.V.row(F(f, (exit_halfedge % 3 + 1) % 3)).transpose());
+        dangling.push_back({s, exit_halfedge, ev.vertex, acc});
+        ++res_.stats.n_boundary_crossings;
         continue;
       }
       const Location loc = locate(f, q);
@@ -551,25 +633,161 @@ class Extractor {
       if (end < 0)
         return core::Status::internal("extract_quads: iso-line from grid point " +
                                       std::to_string(slots_[s].grid) + " ends at an unregistered point");
-      // Turn left at the end: direction d+1, starting just beside the reversed incoming line.
-      const auto [g, to_g] = locate_near(f, q, loc, rot_dir(d, 2), rot_dir(d, 1));
-      if (g < 0) continue;  // no face to the left: the end point is on the boundary
-      const int dir = rot_dir(d, 1 + to_g.r);
-      for (int n = slot_begin_[end]; n < slot_begin_[end + 1]; ++n)
-        if (slots_[n].face == g && slots_[n].dir == dir) he_next_[s] = n;
-      if (he_next_[s] < 0)
-        return core::Status::internal("extract_quads: no outgoing iso-line at grid point " +
-                                      std::to_string(end) + " to turn into");
-      he_to_next_[s] = compose(to_g, acc);
+      // Turn left at the end: direction d+1, starting just beside it (towards the incoming line).
+      const auto [g, to_g] = locate_cw(f, q, loc, rot_dir(d, 1), rot_dir(d, 2));
+      if (g >= 0) {
+        he_next_[s] = find_slot(end, g, rot_dir(d, 1 + to_g.r));
+        if (he_next_[s] < 0)
+          return core::Status::internal("extract_quads: no outgoing iso-line at grid point " +
+                                        std::to_string(end) + " to turn into");
+        he_to_next_[s] = compose(to_g, acc);
+      } else {
+        pending_boundary_.push_back({s, end, f, q, loc, acc});
+      }
+    }
+    // Boundary events of grid points inside boundary edges, then every edge's events in order.
+    for (size_t g = 0; g < grid_.size(); ++g)
+      if (grid_[g].where == Where::kEdge && twin_[grid_[g].elem] < 0)
+        boundary_events_[grid_[g].elem].push_back(
+            BoundaryEvent{false, 0, 0, 0, grid_[g].p, static_cast<int>(g)});
+    for (auto& [h, events] : boundary_events_) {
+      std::sort(events.begin(), events.end(), [&, hh = h](const BoundaryEvent& x, const BoundaryEvent& y) {
+        return event_before(hh, x, y);
+      });
+      for (size_t i = 0; i < events.size(); ++i) event_position_[events[i].vertex] = {h, static_cast<int>(i)};
+    }
+    // Iso-lines ending on the boundary: their reverse starts there and turns left at the start
+    // grid point; the trace itself continues along the boundary.
+    for (const Dangling& dg : dangling) {
+      const Slot& sl = slots_[dg.slot];
+      const int f_exit = dg.exit_halfedge / 3;
+      const int rev = add_halfedge(dg.event_vertex, f_exit, extra_uv_[dg.event_vertex - grid_.size()]);
+      reverse_of_vertex_[dg.event_vertex] = rev;
+      const Location loc = locate(sl.face, sl.p);
+      // Arriving at the start point along −dir; turn left: direction −(dir+1).
+      const auto [g, to_g] = locate_cw(sl.face, sl.p, loc, rot_dir(sl.dir, 3), sl.dir);
+      const Transform back = inverse(dg.acc);  // exit chart → start chart
+      if (g >= 0) {
+        he_next_[rev] = find_slot(sl.grid, g, rot_dir(sl.dir, 3 + to_g.r));
+        if (he_next_[rev] < 0)
+          return core::Status::internal("extract_quads: no outgoing iso-line at grid point " +
+                                        std::to_string(sl.grid) + " to turn into");
+        he_to_next_[rev] = compose(to_g, back);
+      } else {
+        pending_boundary_.push_back({rev, sl.grid, sl.face, sl.p, loc, back});
+      }
+      he_to_next_[dg.slot] = dg.acc;
+      he_next_[dg.slot] = boundary_halfedge(dg.event_vertex);
+    }
+    // Iso-lines arriving at a boundary grid point with no face to their left turn onto the boundary.
+    for (const PendingBoundary& pb : pending_boundary_) {
+      const auto [c_face, to_c] = cw_most(pb.face, pb.loc);
+      he_next_[pb.halfedge] = boundary_halfedge(pb.grid);
+      he_to_next_[pb.halfedge] = compose(to_c, pb.acc);
+      (void)c_face;
+    }
+    // Boundary half-edges (created on demand; creating one may require the next).
+    for (size_t i = 0; i < boundary_work_.size(); ++i) {
+      if (auto s = link_boundary_halfedge(boundary_work_[i]); !s.is_ok()) return s;
     }
     return core::Status::ok();
+  }
+
+  // The clockwise-most face around the element of a point of face f on the boundary, and the
+  // transform from f's chart to it.
+  std::pair<int, Transform> cw_most(int f, const Location& loc) const {
+    if (loc.where != Where::kVertex) return {f, Transform{}};
+    Transform acc;
+    int c = 3 * f + loc.k;
+    for (int next = cw_corner(c); next >= 0 && next != 3 * f + loc.k; next = cw_corner(c)) {
+      acc = compose(trans_[c], acc);
+      c = next;
+    }
+    return {c / 3, acc};
+  }
+
+  // Quad half-edge along the boundary starting at boundary vertex `vertex` (created on demand).
+  int boundary_halfedge(int vertex) {
+    if (auto it = boundary_he_.find(vertex); it != boundary_he_.end()) return it->second;
+    int face;
+    Eigen::Vector2d start_uv;
+    if (vertex >= static_cast<int>(grid_.size())) {
+      face = event_position_.at(vertex).first / 3;
+      start_uv = extra_uv_[vertex - grid_.size()];
+    } else if (grid_[vertex].where == Where::kVertex) {
+      const int c = fan_start_[grid_[vertex].elem];
+      face = c / 3;
+      start_uv = uv_[c];
+    } else {
+      face = grid_[vertex].face;
+      start_uv = to_vec(grid_[vertex].p);
+    }
+    const int h = add_halfedge(vertex, face, start_uv);
+    boundary_he_.emplace(vertex, h);
+    boundary_work_.push_back(h);
+    return h;
+  }
+
+  // Walks forward along the boundary from the start of boundary half-edge he to the next
+  // boundary vertex, and links he to the half-edge that leaves it with the face on its left.
+  core::Status link_boundary_halfedge(int he) {
+    const int vertex = he_vertex_[he];
+    int h, index;  // current boundary half-edge of the triangle mesh and event index on it
+    if (vertex >= static_cast<int>(grid_.size()) || grid_[vertex].where == Where::kEdge) {
+      std::tie(h, index) = event_position_.at(vertex);
+    } else {
+      h = fan_start_[grid_[vertex].elem];
+      index = -1;
+    }
+    Transform acc;  // start chart → chart of face(h)
+    for (int step = 0; step <= 3 * nf_; ++step) {
+      const auto it = boundary_events_.find(h);
+      if (it != boundary_events_.end() && index + 1 < static_cast<int>(it->second.size())) {
+        const BoundaryEvent& ev = it->second[index + 1];
+        if (ev.is_line) {
+          he_next_[he] = reverse_of_vertex_.at(ev.vertex);
+          he_to_next_[he] = acc;
+        } else {
+          const int slot = ccw_most_slot(ev.vertex, h / 3);
+          he_next_[he] = slot >= 0 ? slot : boundary_halfedge(ev.vertex);
+          he_to_next_[he] = acc;
+        }
+        return core::Status::ok();
+      }
+      // Past the last event: the head vertex of h.
+      const int c_head = 3 * (h / 3) + (h % 3 + 1) % 3;
+      const int v = map_.mesh.F(c_head / 3, c_head % 3);
+      if (auto git = vertex_grid_.find(v); git != vertex_grid_.end()) {
+        // Clockwise around v from the counter-clockwise-most face: the first outgoing slot.
+        Transform around = acc;
+        for (int c = c_head; c >= 0; c = cw_corner(c)) {
+          const int slot = ccw_most_slot(git->second, c / 3);
+          if (slot >= 0) {
+            he_next_[he] = slot;
+            he_to_next_[he] = around;
+            return core::Status::ok();
+          }
+          if (cw_corner(c) >= 0) around = compose(trans_[c], around);
+        }
+        he_next_[he] = boundary_halfedge(git->second);
+        he_to_next_[he] = around;
+        return core::Status::ok();
+      }
+      // No boundary vertex at v: continue on the boundary half-edge leaving v.
+      const int c_next = fan_start_[v];
+      acc = compose(inverse(corner_chart_[c_head]), acc);
+      h = c_next;
+      index = -1;
+    }
+    return core::Status::internal("extract_quads: boundary walk from vertex " + std::to_string(vertex) +
+                                  " does not terminate");
   }
 
   core::Status build_faces() {
     auto& quads = res_.quads;
     quads = core::PolyMesh{};
     const auto& V = map_.mesh.V;
-    quads.V.resize(static_cast<int>(grid_.size()), 3);
+    quads.V.resize(n_out_vertices_, 3);
     for (size_t i = 0; i < grid_.size(); ++i) {
       const GridPoint& g = grid_[i];
       if (g.where == Where::kVertex) {
@@ -589,10 +807,12 @@ class Extractor {
       quads.V.row(i) = la * V.row(F(g.face, 0)) + lb * V.row(F(g.face, 1)) +
                        (1.0 - la - lb) * V.row(F(g.face, 2));
     }
-    const int n_slots = static_cast<int>(slots_.size());
-    std::vector<char> visited(n_slots, 0);
-    std::vector<int> cycle, face_uv_rows;
-    for (int s0 = 0; s0 < n_slots; ++s0) {
+    for (size_t i = 0; i < extra_pos_.size(); ++i) quads.V.row(grid_.size() + i) = extra_pos_[i];
+    const int n_he = static_cast<int>(he_vertex_.size());
+    std::vector<char> visited(n_he, 0);
+    std::vector<int> cycle;
+    std::vector<double> face_uv_rows;
+    for (int s0 = 0; s0 < n_he; ++s0) {
       if (visited[s0]) continue;
       cycle.clear();
       bool closed = false;
@@ -609,12 +829,12 @@ class Extractor {
       std::vector<int> verts, uvs;
       Transform to_current;  // chart of the first corner → chart of the current corner
       for (int s : cycle) {
-        verts.push_back(slots_[s].grid);
+        verts.push_back(he_vertex_[s]);
         if (opt_.output_uv) {
-          const IVec p = inverse(to_current).apply(slots_[s].p);
+          const Eigen::Vector2d p = inverse(to_current).apply(he_uv_[s]);
           uvs.push_back(static_cast<int>(face_uv_rows.size() / 2));
-          face_uv_rows.push_back(p.x);
-          face_uv_rows.push_back(p.y);
+          face_uv_rows.push_back(p.x());
+          face_uv_rows.push_back(p.y());
         }
         to_current = compose(he_to_next_[s], to_current);
       }
@@ -631,6 +851,13 @@ class Extractor {
     return core::Status::ok();
   }
 
+  struct PendingBoundary {  // a half-edge ending at a boundary grid point, no face to its left
+    int halfedge, grid, face;
+    IVec p;
+    Location loc;
+    Transform acc;  // start chart of the half-edge → chart of `face`
+  };
+
   const core::UVMesh& map_;
   const ExtractOptions& opt_;
   ExtractResult& res_;
@@ -646,10 +873,22 @@ class Extractor {
   std::vector<GridPoint> grid_;
   std::unordered_map<Key, int, KeyHash> grid_key_;  // face / owning-edge points
   std::unordered_map<int, int> vertex_grid_;        // vertex id → grid point
-  std::vector<Slot> slots_;                         // = quad half-edges
+  std::vector<Slot> slots_;                         // outgoing iso-lines = first quad half-edges
   std::vector<int> slot_begin_;                     // per grid point, CSR into slots_
-  std::vector<int> he_next_;
+  // Quad half-edges: slots first, then reverses of iso-lines that end on the boundary and
+  // half-edges along the boundary. Start vertex, start chart (face) and UV there, next in face.
+  std::vector<int> he_vertex_, he_face_, he_next_;
+  std::vector<Eigen::Vector2d> he_uv_;
   std::vector<Transform> he_to_next_;  // start chart of a half-edge → start chart of its next
+  int n_out_vertices_ = 0;             // grid points, then boundary crossings
+  std::vector<Eigen::Vector2d> extra_uv_;  // per boundary crossing: UV in its edge's face chart
+  std::vector<Eigen::Vector3d> extra_pos_;
+  std::unordered_map<int, std::vector<BoundaryEvent>> boundary_events_;  // boundary half-edge →
+  std::unordered_map<int, std::pair<int, int>> event_position_;  // vertex → (half-edge, index)
+  std::unordered_map<int, int> reverse_of_vertex_;  // crossing vertex → half-edge leaving inwards
+  std::unordered_map<int, int> boundary_he_;        // boundary vertex → boundary half-edge
+  std::vector<int> boundary_work_;
+  std::vector<PendingBoundary> pending_boundary_;
 };
 
 }  // namespace

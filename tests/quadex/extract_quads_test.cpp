@@ -211,6 +211,62 @@ UVMesh torus(int a, int b, double pu, double pv) {
   return m;
 }
 
+// An open disk made of k quadrants [0,n]² (each an m×m grid, alternating diagonals) glued
+// cyclically around the origin with 90° rotations: a cone of index 4 - k at the origin, a
+// boundary aligned with the iso-lines. Positions squeeze the quadrants into a planar fan.
+UVMesh cone_disk(int k, int m, int n) {
+  std::map<std::array<int, 3>, int> index;
+  std::vector<Eigen::Vector3d> verts;
+  auto vid = [&](int q, int i, int j) {
+    std::array<int, 3> key{q, i, j};
+    if (i == 0 && j == 0) key = {-1, 0, 0};
+    else if (i == 0) key = {(q + 1) % k, j, 0};
+    auto [it, inserted] = index.try_emplace(key, static_cast<int>(verts.size()));
+    if (inserted) {
+      const double x = double(i) / m, y = double(j) / m;
+      const double rho = std::hypot(x, y), phi = (q + std::atan2(y, x) / (M_PI / 2)) * 2 * M_PI / k;
+      verts.emplace_back(rho * std::cos(phi), rho * std::sin(phi), 0.0);
+    }
+    return it->second;
+  };
+  std::vector<std::array<int, 3>> tris;
+  std::vector<std::array<Eigen::Vector2d, 3>> uvs;
+  for (int q = 0; q < k; ++q)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        auto uv = [&](int a, int b) { return Eigen::Vector2d(double(n) * a / m, double(n) * b / m); };
+        const int a = vid(q, i, j), b = vid(q, i + 1, j), c = vid(q, i + 1, j + 1), d = vid(q, i, j + 1);
+        if ((i + j) % 2) {
+          tris.push_back({a, b, c}), uvs.push_back({uv(i, j), uv(i + 1, j), uv(i + 1, j + 1)});
+          tris.push_back({a, c, d}), uvs.push_back({uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)});
+        } else {
+          tris.push_back({a, b, d}), uvs.push_back({uv(i, j), uv(i + 1, j), uv(i, j + 1)});
+          tris.push_back({b, c, d}), uvs.push_back({uv(i + 1, j), uv(i + 1, j + 1), uv(i, j + 1)});
+        }
+      }
+  UVMesh out;
+  out.mesh.V.resize(static_cast<int>(verts.size()), 3);
+  for (size_t i = 0; i < verts.size(); ++i) out.mesh.V.row(i) = verts[i];
+  out.mesh.F.resize(static_cast<int>(tris.size()), 3);
+  out.corner_uv.resize(3 * static_cast<int>(tris.size()), 2);
+  for (size_t f = 0; f < tris.size(); ++f)
+    for (int c = 0; c < 3; ++c) {
+      out.mesh.F(f, c) = tris[f][c];
+      out.corner_uv.row(3 * f + c) = uvs[f][c];
+    }
+  return out;
+}
+
+// Signed area of a polygon's projection to the xy plane (shoelace).
+double xy_area(const core::PolyMesh& m, int f) {
+  double a = 0;
+  for (int k = 0; k < m.degree(f); ++k) {
+    const int i = m.vertex(f, k), j = m.vertex(f, (k + 1) % m.degree(f));
+    a += m.V(i, 0) * m.V(j, 1) - m.V(j, 0) * m.V(i, 1);
+  }
+  return 0.5 * a;
+}
+
 void expect_all_quads(const ExtractResult& r, int n_quads, const std::string& name) {
   ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
   EXPECT_EQ(r.quads.n_faces(), n_quads) << name;
@@ -299,6 +355,59 @@ TEST(ExtractQuads, FlatTorusIsRegular) {
   EXPECT_EQ(c.euler, 0);
   EXPECT_EQ(c.valences[4], 24) << "every vertex must have valence 4";
   EXPECT_EQ(r.stats.n_cones, 0);
+}
+
+TEST(ExtractQuads, OpenDiskConesHaveValenceThreeAndFive) {
+  for (const auto& [k, m, n] : std::vector<std::array<int, 3>>{{5, 3, 2}, {3, 3, 2}, {5, 2, 2}, {6, 4, 3}}) {
+    const std::string name = "cone disk with " + std::to_string(k) + " quadrants, m=" +
+                             std::to_string(m) + " n=" + std::to_string(n);
+    const ExtractResult r = extract_quads(cone_disk(k, m, n));
+    expect_all_quads(r, k * n * n, name);
+    EXPECT_EQ(r.stats.n_cones, 1) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.n_boundary_edges, 2 * k * n) << name;
+    // Interior: the cone (valence k) and valence-4 vertices; boundary: 2kn vertices, the k
+    // outer corners of valence 2, the others of valence 3.
+    const int n_boundary_valence3 = 2 * k * n - k;
+    EXPECT_EQ(c.valences[k], 1 + (k == 3 ? n_boundary_valence3 : 0)) << name;
+    EXPECT_EQ(c.valences[2], k) << name;
+    EXPECT_EQ(c.valences[3], n_boundary_valence3 + (k == 3 ? 1 : 0)) << name;
+    EXPECT_EQ(c.valences[4], k * (n - 1) * (n - 1) + k * (n - 1)) << name;
+  }
+}
+
+TEST(ExtractQuads, BoundaryCrossingIsoLinesMakeBoundaryVertices) {
+  // [0,4]² with UV = (x + 0.5, y + 0.3): the boundary cuts cells. Lines u = 1..4 and v = 1..4
+  // give 5×5 cells: 9 interior unit quads, 12 cut quads along the sides, 4 corner triangles.
+  for (const bool seam : {false, true}) {
+    const std::string name = seam ? "offset map with seam" : "offset map";
+    UVMesh map = planar_grid(6, 4.0, 1.0, 13);
+    for (int c = 0; c < map.corner_uv.rows(); ++c) map.corner_uv.row(c) += Eigen::Vector2d(0.5, 0.3);
+    if (seam) add_seam(map, 2.1, 3, Eigen::Vector2d(-2, 5));
+    const ExtractResult r = extract_quads(map);
+    ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+    EXPECT_EQ(r.quads.n_faces(), 25) << name;
+    EXPECT_EQ(r.stats.n_non_quads, 4) << name;
+    EXPECT_EQ(r.stats.n_boundary_crossings, 16) << name;
+    EXPECT_EQ(r.stats.n_dropped_faces, 0) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.degrees[3], 4) << name;
+    EXPECT_EQ(c.degrees[4], 21) << name;
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.n_boundary_edges, 16) << name;
+    EXPECT_EQ(c.n_used_vertices, 32) << name;
+    double total = 0, min_area = 1e300;
+    for (int f = 0; f < r.quads.n_faces(); ++f) {
+      total += xy_area(r.quads, f);
+      min_area = std::min(min_area, xy_area(r.quads, f));
+    }
+    // The domain minus the four corners cut off by the first iso-lines: 16 - 2·0.175 - 2·0.075.
+    EXPECT_NEAR(total, 15.5, 1e-9) << name;
+    EXPECT_GT(min_area, 0.07) << name << ": a face is inverted or degenerate";
+  }
 }
 
 TEST(ExtractQuads, RejectsNonSeamlessMap) {

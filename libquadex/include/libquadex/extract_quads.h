@@ -39,8 +39,8 @@ struct ExtractStats {
   int n_grid_points_in_faces = 0;      // grid points inside a triangle
   int n_cones = 0;                     // interior vertices whose holonomy is a nonzero rotation
   int n_seam_edges = 0;                // interior edges with a non-identity transition
-  int n_dropped_faces = 0;  // half-edge cycles that could not be closed (cut by the boundary)
-  int n_dangling_halfedges = 0;  // iso-line pieces that end on the boundary, not at a grid point
+  int n_boundary_crossings = 0;  // quad vertices where an iso-line crosses the boundary
+  int n_dropped_faces = 0;  // half-edge chains that did not close into a face (not expected)
   double max_transition_residual = 0;  // measured, in UV units
   double seconds = 0;
 };
@@ -68,10 +68,11 @@ struct ExtractResult {
 // predicates with a symbolic perturbation (each iso-line is shifted infinitesimally to its
 // left), so iso-lines through mesh vertices or along mesh edges need no special case. Faces
 // are the cycles of "turn left at the end vertex"; valence follows the cones (3 at a +π/2 cone).
-// Open meshes: a boundary made of iso-line pieces (e.g. a quantized, boundary-aligned map)
-// yields ordinary boundary quads. Iso-lines that leave the mesh through a non-aligned boundary
-// are not turned into boundary edges: the cells they cut are dropped and counted in
-// n_dropped_faces / n_dangling_halfedges, so the output then has holes along that boundary.
+// Open meshes: the quad-mesh boundary follows the mesh boundary. Its vertices are the grid points
+// on the boundary plus the points where an iso-line crosses the boundary (positions interpolated
+// along the boundary edge, non-integer UVs); consecutive ones are joined by a quad edge. A
+// boundary made of iso-line pieces (a boundary-aligned map) thus yields only quads; a boundary
+// cutting through cells yields cut faces of degree ≠ 4, counted in n_non_quads.
 // Returns kOk, kInvalidInput (see above) or kInternal (a tracing invariant failed: a bug).
 [[nodiscard]] ExtractResult extract_quads(const core::UVMesh& map, const ExtractOptions& options = {});
 
