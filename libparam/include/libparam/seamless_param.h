@@ -1,0 +1,104 @@
+// Direct seamless parametrization (Levi 2021, "Direct Seamless Parametrization", sections 3–5
+// and 8.1): cut along a dual spanning tree, lay out isometrically, then round the seam matchings
+// in batches of increasing rounding error while re-optimizing a flip-free layout subject to the
+// seamlessness constraints e' = R_90^r e of the rounded edges.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/status.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace quadify::param {
+
+// Distortion measure minimised by the layout optimization (paper section 8.5).
+enum class Energy {
+  kTau,                // max distortion τ = sqrt(σ1max/σ2min): symmetric Dirichlet, then an L^p
+                       // continuation of it that drives the maximum down; flip-free
+  kSymmetricDirichlet, // Σ area·(σ1² + σ1⁻² + σ2² + σ2⁻²); a barrier, flip-free
+  kArap,               // Σ area·((σ1−1)² + (σ2−1)²); no barrier (flips are counted, not prevented)
+  kLinfArap,           // L^p ARAP with a large p, approximating the max ARAP distortion
+  kConformal,          // MIPS conformal energy Σ area·(σ1/σ2 + σ2/σ1); scale-free
+};
+
+// Order of the batches of matching rounding (paper 8.1).
+enum class RoundingOrder {
+  kBottomUp,  // ε = step, 2·step, …, 0.5: round the most certain matchings first (default)
+  kTopDown,   // ε = 0.5−step, …, 0: round matchings with rounding error ≥ ε first
+};
+
+struct ParamOptions {
+  Energy energy = Energy::kTau;
+  RoundingOrder order = RoundingOrder::kBottomUp;
+  // Increment of the rounding-error threshold ε between batches, in quarter turns (paper: 0.1).
+  double threshold_step = 0.1;
+  // Choose floor/ceil of uncertain matchings by laying out a local patch both ways (paper §5).
+  bool local_estimation = true;
+  // Matchings with rounding error ≥ this (quarter turns) go through local estimation (paper: 0.3).
+  double local_estimation_min_error = 0.3;
+  // Size of a local-estimation patch: vertex-ring BFS levels around the edge (paper: 5).
+  int patch_bfs_levels = 5;
+  // Newton iterations per layout optimization (one per batch and per penalty stage).
+  int max_newton_iters = 60;
+  // Allowed seam residual |e' − R^r e| of the result, relative to the bounding-box diagonal.
+  double seam_tol = 1e-9;
+  // Worker threads for components and local-estimation patches; 0 = all hardware threads.
+  // The result does not depend on this number.
+  int threads = 0;
+  // Optional progress callback (stage name, step, number of steps); called from the calling
+  // thread only.
+  std::function<void(const std::string& stage, int step, int n_steps)> progress;
+};
+
+struct ParamStats {
+  int n_components = 0;
+  int n_seam_edges = 0;        // interior edges not in the dual spanning tree
+  int n_cones = 0;             // interior vertices with a non-zero index
+  int n_patches = 0;           // local-estimation patches laid out
+  int n_improved = 0;          // patches whose choice differs from the nearest rounding
+  int n_batches = 0;           // rounding batches that rounded at least one matching
+  int total_iterations = 0;    // Newton iterations over all optimizations (global layout)
+  int n_flipped = 0;           // faces with non-positive UV orientation (exact predicate)
+  double tau = 0;              // sqrt(σ1max/σ2min) of the final map; +inf if flipped
+  double sd_max = 0;           // max per-face symmetric Dirichlet energy (4 = isometry)
+  double seam_residual = 0;    // max |e' − R^r e| over seam edges, in UV units
+  double seconds_cut = 0, seconds_optimize = 0, seconds_local_estimation = 0,
+         seconds_total = 0;
+};
+
+// One seam edge of the result: the edge (edge_vertex0, edge_vertex1) shared by face_a and face_b.
+// With e_a = uv_a(v1) − uv_a(v0) in face_a and e_b likewise in face_b: e_b = R_90^matching e_a.
+struct SeamMatching {
+  int face_a = -1, face_b = -1;
+  int edge_vertex0 = -1, edge_vertex1 = -1;
+  int matching = 0;  // quarter turns, 0..3
+};
+
+// An interior vertex where the UV angle sum differs from 2π: index = 4 − angle_sum/(π/2)
+// (quarter turns; +1 at a valence-3-like cone, −1 at a valence-5-like cone).
+struct ConeInfo {
+  int vertex = -1;
+  int index = 0;
+};
+
+struct ParamResult {
+  core::Status status;
+  core::UVMesh uv;                 // the input mesh with (#F·3)×2 corner UVs
+  std::vector<SeamMatching> seams;
+  std::vector<ConeInfo> cones;
+  ParamStats stats;
+};
+
+// Computes a seamless parametrization of every connected component of `mesh` (Alg. 1 of the
+// paper, with local estimation of §5). Components are processed independently (in parallel
+// when built with TBB) and are laid out in separate UV charts that may overlap.
+// Preconditions: manifold, consistently oriented, finite V, non-degenerate triangles.
+// Returns kInvalidInput on a violated precondition or bad options, kNumericalFailure when a
+// factorization fails, kNotConverged when the seamless layout could not be made flip-free
+// (the result is still returned, with stats.n_flipped > 0).
+[[nodiscard]] ParamResult compute_seamless_param(const core::TriMesh& mesh,
+                                                 const ParamOptions& options = {});
+
+}  // namespace quadify::param

@@ -1,0 +1,68 @@
+// Cutting a connected mesh along a dual spanning tree and laying it out isometrically
+// (paper section 4, "Initialization"). Internal to libparam.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/topology.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <utility>
+#include <vector>
+
+namespace quadify::param {
+
+// A seam edge of the cut: an interior edge that is not in the dual spanning tree. Its twin
+// half-edges are he_a (in face he_a/3, running v0→v1) and he_b (in face he_b/3, running v1→v0).
+struct CutSeam {
+  int he_a = -1, he_b = -1;
+  int edge = -1;  // EdgeTopology edge id
+};
+
+struct CutMesh {
+  core::EdgeTopology topo;
+  std::vector<int> tree_parent_halfedge;  // #F, half-edge of the parent face across the tree edge
+                                          // (-1 at the root face)
+  std::vector<int> face_order;            // #F, BFS order of the faces (root first)
+  std::vector<int> corner_copy;           // #F·3, vertex copy of each corner
+  std::vector<int> copy_vertex;           // #copies, mesh vertex of each copy
+  int n_copies() const { return static_cast<int>(copy_vertex.size()); }
+  std::vector<CutSeam> seams;             // every non-tree interior edge
+  int root_copy = 0;                      // a copy of the root face, kept fixed (translation gauge)
+  // Rest shape of each face in an isometric 2D frame of its 3D triangle: the 2×2 matrix
+  // Dm = [p1−p0, p2−p0] with p0 = 0 and p1 on the positive x axis.
+  std::vector<Eigen::Matrix2d> rest;      // #F
+  std::vector<double> area;               // #F, 3D area
+};
+
+// Cuts a connected, manifold, consistently oriented mesh along a BFS dual spanning tree rooted at
+// face `seed_face`. Vertex copies are the corners merged across the tree edges (in BFS order, so
+// copy ids grow away from the root).
+CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face = 0);
+
+// Isometric layout of the cut mesh, face by face in BFS order: (#copies)×2 positions.
+Eigen::MatrixX2d isometric_unfold(const core::TriMesh& mesh, const CutMesh& cut);
+
+// Continuous matching of each seam, in quarter turns in (−2, 2]: the rotation from
+// e_a = x(v1 in face a) − x(v0 in face a) to e_b = x(v1 in face b) − x(v0 in face b).
+std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d& x);
+
+// The two scalar rows of the constraint e_b − R^r e_a = 0 of seam s, as (variable, coefficient)
+// triplets over the 2·#copies scalar variables (variable 2·copy + d). Duplicates are summed.
+struct SparseRow {
+  std::vector<std::pair<int, double>> entries;
+};
+std::array<SparseRow, 2> seam_constraint_rows(const CutMesh& cut, int seam, int matching);
+
+// Applies R_90^r to a 2-vector.
+inline Eigen::Vector2d rotate_quarter(const Eigen::Vector2d& e, int r) {
+  switch (((r % 4) + 4) % 4) {
+    case 0: return e;
+    case 1: return {-e.y(), e.x()};
+    case 2: return -e;
+    default: return {e.y(), -e.x()};
+  }
+}
+
+}  // namespace quadify::param

@@ -1,0 +1,432 @@
+#include "layout_optimizer.h"
+
+#include <libcore/predicates.h>
+#include <libcore/sparse_solver.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <limits>
+
+namespace quadify::param {
+namespace {
+
+// Problems with at most this many reduced variables use a dense Cholesky (local patches).
+constexpr int kDenseMaxVariables = 600;
+// Fraction of the largest flip-free step actually taken, so triangles keep a positive area.
+constexpr double kFlipFreeStepFraction = 0.8;
+// Armijo sufficient-decrease constant and the number of halvings before giving up.
+constexpr double kArmijo = 1e-4;
+constexpr int kMaxBacktracks = 40;
+// Diagonal shift relative to the mean Hessian diagonal: removes the global-rotation null space.
+constexpr double kRegularization = 1e-9;
+
+// One element of the energy: local scalar variables, mapped to reduced variables by M (dense
+// n_local × n_reduced, rows = P rows), the reduced ids, and the offsets of its Hessian entries.
+struct Element {
+  std::vector<int> ys;
+  Eigen::MatrixXd M;
+  std::vector<int> offsets;  // ys.size()² positions in the Hessian value array (sparse) or -1
+};
+
+Element make_element(const Reduction& red, const std::vector<int>& xvars) {
+  Element el;
+  for (int v : xvars)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
+      el.ys.push_back(static_cast<int>(it.col()));
+  std::sort(el.ys.begin(), el.ys.end());
+  el.ys.erase(std::unique(el.ys.begin(), el.ys.end()), el.ys.end());
+  el.M = Eigen::MatrixXd::Zero(xvars.size(), el.ys.size());
+  for (size_t i = 0; i < xvars.size(); ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, xvars[i]); it; ++it) {
+      const auto pos = std::lower_bound(el.ys.begin(), el.ys.end(), static_cast<int>(it.col()));
+      el.M(i, pos - el.ys.begin()) += it.value();
+    }
+  return el;
+}
+
+// Gradient matrix G (3×2) of the barycentric basis: J = Σ_k x_k ⊗ G_k.
+Eigen::Matrix<double, 3, 2> basis_gradients(const Eigen::Matrix2d& dm_inv) {
+  Eigen::Matrix<double, 3, 2> g;
+  g.row(0) = -dm_inv.row(0) - dm_inv.row(1);
+  g.row(1) = dm_inv.row(0);
+  g.row(2) = dm_inv.row(1);
+  return g;
+}
+
+struct Problem {
+  const LayoutDomain& domain;
+  const Reduction& red;
+  const OptimizeSettings& s;
+  std::vector<Element> faces, rows;
+  std::vector<Eigen::VectorXd> row_coefs;  // coefficients of each penalty row (local order)
+  bool dense = false;
+  Eigen::SparseMatrix<double> H;           // pattern (sparse mode)
+  Eigen::MatrixXd Hd;                      // dense mode
+
+  Problem(const LayoutDomain& d, const Reduction& r, const OptimizeSettings& st)
+      : domain(d), red(r), s(st) {
+    faces.reserve(d.n_faces());
+    for (const auto& fc : d.face_copies)
+      faces.push_back(make_element(r, {2 * fc[0], 2 * fc[0] + 1, 2 * fc[1], 2 * fc[1] + 1,
+                                       2 * fc[2], 2 * fc[2] + 1}));
+    if (s.penalty_rows) {
+      for (const auto& row : *s.penalty_rows) {
+        std::vector<int> xv;
+        Eigen::VectorXd co(row.entries.size());
+        for (size_t i = 0; i < row.entries.size(); ++i) {
+          xv.push_back(row.entries[i].first);
+          co[i] = row.entries[i].second;
+        }
+        rows.push_back(make_element(r, xv));
+        row_coefs.push_back(co);
+      }
+    }
+    const int n = r.n_free();
+    dense = n <= kDenseMaxVariables;
+    if (dense) {
+      Hd = Eigen::MatrixXd::Zero(n, n);
+      return;
+    }
+    std::vector<Eigen::Triplet<double>> trip;
+    for (int i = 0; i < n; ++i) trip.emplace_back(i, i, 0.0);
+    auto collect = [&](const Element& el) {
+      for (int a : el.ys)
+        for (int b : el.ys) trip.emplace_back(a, b, 0.0);
+    };
+    for (const auto& el : faces) collect(el);
+    for (const auto& el : rows) collect(el);
+    H.resize(n, n);
+    H.setFromTriplets(trip.begin(), trip.end());
+    H.makeCompressed();
+    auto locate = [&](Element& el) {
+      el.offsets.resize(el.ys.size() * el.ys.size());
+      for (size_t j = 0; j < el.ys.size(); ++j) {
+        const int col = el.ys[j];
+        const int* begin = H.innerIndexPtr() + H.outerIndexPtr()[col];
+        const int* end = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
+        for (size_t i = 0; i < el.ys.size(); ++i)
+          el.offsets[j * el.ys.size() + i] =
+              static_cast<int>(std::lower_bound(begin, end, el.ys[i]) - H.innerIndexPtr());
+      }
+    };
+    for (auto& el : faces) locate(el);
+    for (auto& el : rows) locate(el);
+  }
+
+  // Energy of x; with gradient g (reduced) and Hessian assembled when `derivatives`.
+  double evaluate(const Eigen::VectorXd& x, bool derivatives, Eigen::VectorXd* g) {
+    double energy = 0;
+    if (derivatives) {
+      g->setZero(red.n_free());
+      if (dense)
+        Hd.setZero();
+      else
+        std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
+    }
+    auto scatter = [&](const Element& el, const Eigen::VectorXd& gl, const Eigen::MatrixXd& hl) {
+      const Eigen::VectorXd gy = el.M.transpose() * gl;
+      const Eigen::MatrixXd hy = el.M.transpose() * hl * el.M;
+      const size_t k = el.ys.size();
+      for (size_t i = 0; i < k; ++i) (*g)[el.ys[i]] += gy[i];
+      if (dense) {
+        for (size_t j = 0; j < k; ++j)
+          for (size_t i = 0; i < k; ++i) Hd(el.ys[i], el.ys[j]) += hy(i, j);
+      } else {
+        double* vals = H.valuePtr();
+        for (size_t j = 0; j < k; ++j)
+          for (size_t i = 0; i < k; ++i) vals[el.offsets[j * k + i]] += hy(i, j);
+      }
+    };
+    Eigen::VectorXd g6(6);
+    Eigen::MatrixXd h6(6, 6);
+    for (int f = 0; f < domain.n_faces(); ++f) {
+      const auto& fc = domain.face_copies[f];
+      Eigen::Matrix2d X;
+      for (int d = 0; d < 2; ++d) {
+        X(d, 0) = x[2 * fc[1] + d] - x[2 * fc[0] + d];
+        X(d, 1) = x[2 * fc[2] + d] - x[2 * fc[0] + d];
+      }
+      const Eigen::Matrix2d J = X * domain.rest_inverse[f];
+      const DensityEval ev = evaluate_density(s.density, s.power, J, derivatives, true);
+      if (!ev.finite) return std::numeric_limits<double>::infinity();
+      const double a = domain.area[f];
+      energy += a * ev.value;
+      if (!derivatives) continue;
+      // B (4×6): vec(J) index 2d+r, local variable 2k+d, entry G(k, r).
+      const Eigen::Matrix<double, 3, 2> G = basis_gradients(domain.rest_inverse[f]);
+      Eigen::Matrix<double, 4, 6> B = Eigen::Matrix<double, 4, 6>::Zero();
+      for (int k = 0; k < 3; ++k)
+        for (int d = 0; d < 2; ++d)
+          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * k + d) = G(k, r);
+      g6 = a * B.transpose() * ev.gradient;
+      h6 = a * B.transpose() * ev.hessian * B;
+      scatter(faces[f], g6, h6);
+    }
+    for (size_t i = 0; i < rows.size(); ++i) {
+      const Eigen::VectorXd& co = row_coefs[i];
+      double rv = 0;
+      for (Eigen::Index j = 0; j < co.size(); ++j) rv += co[j] * x[(*s.penalty_rows)[i].entries[j].first];
+      energy += s.penalty_weight * rv * rv;
+      if (!derivatives) continue;
+      scatter(rows[i], 2 * s.penalty_weight * rv * co,
+              2 * s.penalty_weight * co * co.transpose());
+    }
+    return energy;
+  }
+};
+
+// Largest t in (0, 1] such that det(X + t·dX) stays positive for every face positive now.
+double max_flip_free_step(const LayoutDomain& domain, const Eigen::VectorXd& x,
+                          const Eigen::VectorXd& dx) {
+  double t_max = std::numeric_limits<double>::infinity();
+  for (const auto& fc : domain.face_copies) {
+    Eigen::Matrix2d X, D;
+    for (int d = 0; d < 2; ++d) {
+      X(d, 0) = x[2 * fc[1] + d] - x[2 * fc[0] + d];
+      X(d, 1) = x[2 * fc[2] + d] - x[2 * fc[0] + d];
+      D(d, 0) = dx[2 * fc[1] + d] - dx[2 * fc[0] + d];
+      D(d, 1) = dx[2 * fc[2] + d] - dx[2 * fc[0] + d];
+    }
+    const double c0 = X.determinant();
+    if (!(c0 > 0)) continue;
+    const double c2 = D.determinant();
+    const double c1 = X(0, 0) * D(1, 1) + D(0, 0) * X(1, 1) - X(0, 1) * D(1, 0) - D(0, 1) * X(1, 0);
+    // Smallest positive root of c2 t² + c1 t + c0.
+    double root = std::numeric_limits<double>::infinity();
+    if (c2 == 0) {
+      if (c1 < 0) root = -c0 / c1;
+    } else {
+      const double disc = c1 * c1 - 4 * c2 * c0;
+      if (disc >= 0) {
+        const double sq = std::sqrt(disc);
+        // Numerically stable roots.
+        const double q = -0.5 * (c1 + (c1 >= 0 ? sq : -sq));
+        const double r1 = q / c2, r2 = q != 0 ? c0 / q : std::numeric_limits<double>::infinity();
+        if (r1 > 0) root = std::min(root, r1);
+        if (r2 > 0) root = std::min(root, r2);
+      }
+    }
+    t_max = std::min(t_max, root);
+  }
+  return t_max;
+}
+
+}  // namespace
+
+LayoutDomain make_domain(const CutMesh& cut) {
+  LayoutDomain d;
+  const int nf = static_cast<int>(cut.rest.size());
+  d.n_copies = cut.n_copies();
+  d.face_copies.resize(nf);
+  d.rest_inverse.resize(nf);
+  d.area = cut.area;
+  for (int f = 0; f < nf; ++f) {
+    d.face_copies[f] = {cut.corner_copy[3 * f], cut.corner_copy[3 * f + 1],
+                        cut.corner_copy[3 * f + 2]};
+    d.rest_inverse[f] = cut.rest[f].inverse();
+  }
+  return d;
+}
+
+Eigen::Matrix2d face_jacobian(const LayoutDomain& domain, int f, const Eigen::VectorXd& x) {
+  const auto& fc = domain.face_copies[f];
+  Eigen::Matrix2d X;
+  for (int d = 0; d < 2; ++d) {
+    X(d, 0) = x[2 * fc[1] + d] - x[2 * fc[0] + d];
+    X(d, 1) = x[2 * fc[2] + d] - x[2 * fc[0] + d];
+  }
+  return X * domain.rest_inverse[f];
+}
+
+Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd& x,
+                               Density density, double power) {
+  Eigen::VectorXd out(domain.n_faces());
+  for (int f = 0; f < domain.n_faces(); ++f)
+    out[f] = evaluate_density(density, power, face_jacobian(domain, f, x), false, false).value;
+  return out;
+}
+
+OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
+                               const OptimizeSettings& settings, Eigen::VectorXd* y) {
+  OptimizeReport rep;
+  Problem prob(domain, red, settings);
+  const int n = red.n_free();
+  Eigen::VectorXd x = red.expand(*y);
+  Eigen::VectorXd g;
+  double energy = prob.evaluate(x, true, &g);
+  rep.initial_energy = energy;
+  if (!std::isfinite(energy)) {
+    rep.status = core::Status::numerical_failure("layout optimization: start is flipped");
+    rep.energy = energy;
+    return rep;
+  }
+  if (n == 0) {
+    rep.energy = energy;
+    return rep;
+  }
+  core::SparseSolver solver;
+  bool analyzed = false;
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    // Newton direction with the PSD-projected Hessian (+ a tiny shift for the rotation mode).
+    Eigen::VectorXd dy;
+    double mean_diag = prob.dense ? prob.Hd.diagonal().mean()
+                                  : Eigen::VectorXd(prob.H.diagonal()).mean();
+    if (!(mean_diag > 0)) mean_diag = 1;
+    double shift = kRegularization * mean_diag;
+    bool solved = false;
+    for (int attempt = 0; attempt < 6 && !solved; ++attempt, shift *= 100) {
+      if (prob.dense) {
+        Eigen::MatrixXd A = prob.Hd;
+        A.diagonal().array() += shift;
+        Eigen::LLT<Eigen::MatrixXd> llt(A);
+        if (llt.info() != Eigen::Success) continue;
+        dy = -llt.solve(g);
+        solved = true;
+      } else {
+        Eigen::SparseMatrix<double> A = prob.H;
+        for (int i = 0; i < n; ++i) A.coeffRef(i, i) += shift;
+        if (!analyzed) {
+          if (!solver.analyze(A).is_ok()) break;
+          analyzed = true;
+        }
+        if (!solver.factorize(A).is_ok()) continue;
+        dy = -solver.solve(g);
+        solved = true;
+      }
+    }
+    if (!solved || !dy.allFinite()) {
+      rep.status = core::Status::numerical_failure("layout optimization: Newton system failed");
+      break;
+    }
+    const double decrement = -g.dot(dy);
+    if (decrement <= settings.relative_tolerance * std::abs(energy)) break;
+    const Eigen::VectorXd dx = red.P * dy;
+    double alpha = std::min(1.0, kFlipFreeStepFraction * max_flip_free_step(domain, x, dx));
+    double trial = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd x_trial;
+    int bt = 0;
+    for (; bt < kMaxBacktracks; ++bt, alpha *= 0.5) {
+      x_trial = x + alpha * dx;
+      trial = prob.evaluate(x_trial, false, nullptr);
+      if (trial <= energy - kArmijo * alpha * decrement) break;
+    }
+    if (bt == kMaxBacktracks) break;  // no decrease possible: converged to round-off
+    *y += alpha * dy;
+    x = red.expand(*y);
+    ++rep.iterations;
+    const double previous = energy;
+    energy = prob.evaluate(x, true, &g);
+    if (previous - energy <= 1e-3 * settings.relative_tolerance * std::abs(previous)) break;
+  }
+  rep.energy = energy;
+  return rep;
+}
+
+}  // namespace quadify::param
+
+namespace quadify::param {
+namespace {
+
+// Penalty weights tried (dimensionless, see move_into_constraints), in increasing order.
+constexpr double kFirstPenalty = 10, kPenaltyGrowth = 10, kLastPenalty = 1e10;
+// Newton iterations per penalty stage.
+constexpr int kPenaltyIterations = 30;
+// Projection is attempted once every new row's residual is below this fraction of the mean
+// seam edge length (the projection then moves vertices by about as much).
+constexpr double kProjectResidual = 1e-3;
+
+// Least-squares y with P·y + c ≈ x.
+Eigen::VectorXd project(const Reduction& red, const Eigen::VectorXd& x, core::Status* status) {
+  const Eigen::SparseMatrix<double> P = red.P;
+  Eigen::SparseMatrix<double> PtP = P.transpose() * P;
+  core::SparseSolver solver;
+  *status = solver.factorize(PtP);
+  if (!status->is_ok()) return red.restrict(x);
+  return solver.solve(P.transpose() * (x - red.c));
+}
+
+}  // namespace
+
+int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x) {
+  int n = 0;
+  for (const auto& fc : domain.face_copies)
+    if (core::orient2d(x.segment<2>(2 * fc[0]), x.segment<2>(2 * fc[1]), x.segment<2>(2 * fc[2])) <= 0)
+      ++n;
+  return n;
+}
+
+TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
+                                       const ConstraintEliminator& elim,
+                                       const std::vector<SparseRow>& new_rows, double weight_unit,
+                                       Eigen::VectorXd* x) {
+  TransitionReport rep;
+  rep.reduction = elim.reduction(*x);
+  // weight_unit = area / Σ edge²: recover the mean squared length of the new seam edges.
+  double area = 0;
+  for (double a : domain.area) area += a;
+  const double mean_edge_sq = area / weight_unit / std::max<size_t>(1, new_rows.size() / 2);
+  double residual_tol = kProjectResidual * std::sqrt(mean_edge_sq);
+  auto max_residual = [&](const Eigen::VectorXd& xx) {
+    double r = 0;
+    for (const auto& row : new_rows) {
+      double v = 0;
+      for (const auto& [var, coef] : row.entries) v += coef * xx[var];
+      r = std::max(r, std::abs(v));
+    }
+    return r;
+  };
+  Eigen::VectorXd y_old = old_red.restrict(*x);
+  Eigen::VectorXd x_cur = *x;
+  Eigen::VectorXd x_best;
+  int best_flips = INT32_MAX;
+  for (double w = kFirstPenalty; w <= kLastPenalty; w *= kPenaltyGrowth) {
+    if (max_residual(x_cur) > residual_tol) {
+      OptimizeSettings st;
+      st.max_iterations = kPenaltyIterations;
+      st.relative_tolerance = 1e-10;
+      st.penalty_rows = &new_rows;
+      st.penalty_weight = w * weight_unit;
+      const OptimizeReport r = optimize_layout(domain, old_red, st, &y_old);
+      rep.iterations += r.iterations;
+      if (!r.status.is_ok()) {
+        rep.status = r.status;
+        break;
+      }
+      x_cur = old_red.expand(y_old);
+      if (max_residual(x_cur) > residual_tol) continue;
+    }
+    core::Status ps;
+    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps);
+    if (!ps.is_ok()) {
+      rep.status = ps;
+      break;
+    }
+    const Eigen::VectorXd x_new = rep.reduction.expand(y_new);
+    const int flips = count_flipped(domain, x_new);
+    if (flips < best_flips) {
+      best_flips = flips;
+      x_best = x_new;
+    }
+    if (flips == 0) break;
+    residual_tol *= 0.1;  // still flipped: get closer to the new space before projecting
+  }
+  if (best_flips == INT32_MAX) {
+    core::Status ps;
+    x_best = rep.reduction.expand(project(rep.reduction, x_cur, &ps));
+    best_flips = count_flipped(domain, x_best);
+  }
+  rep.n_flipped = best_flips;
+  *x = x_best;
+  if (rep.status.is_ok() && best_flips > 0)
+    rep.status = core::Status::not_converged("could not enter the seamless constraint space "
+                                             "without flips (" + std::to_string(best_flips) +
+                                             " flipped faces)");
+  return rep;
+}
+
+}  // namespace quadify::param

@@ -1,0 +1,84 @@
+// Flip-free Newton minimisation of a distortion energy over the reduced variables of the
+// seamlessness constraints (paper eq. 2 with the matchings fixed). Internal to libparam.
+#pragma once
+
+#include "constraint_elimination.h"
+#include "distortion_energy.h"
+
+#include <libcore/status.h>
+
+#include <Eigen/Core>
+
+#include <array>
+#include <vector>
+
+namespace quadify::param {
+
+// The triangles being laid out: each face's three vertex copies and its isometric rest frame.
+struct LayoutDomain {
+  std::vector<std::array<int, 3>> face_copies;
+  std::vector<Eigen::Matrix2d> rest_inverse;  // Dm⁻¹ (see CutMesh::rest)
+  std::vector<double> area;
+  int n_copies = 0;
+  int n_faces() const { return static_cast<int>(face_copies.size()); }
+};
+
+LayoutDomain make_domain(const CutMesh& cut);
+
+struct OptimizeSettings {
+  Density density = Density::kSymmetricDirichlet;
+  double power = 1;             // exponent of the power densities
+  int max_iterations = 60;
+  // Stop when the Newton decrement −gᵀd falls below this fraction of the energy.
+  double relative_tolerance = 1e-9;
+  // Quadratic penalty w·Σ(row·x)² added to the energy (used to move into a smaller constraint
+  // space without flips).
+  const std::vector<SparseRow>* penalty_rows = nullptr;
+  double penalty_weight = 0;
+};
+
+struct OptimizeReport {
+  core::Status status;
+  int iterations = 0;
+  double energy = 0;            // area-weighted density sum (+ penalty)
+  double initial_energy = 0;
+};
+
+// Minimises Σ_f area_f·ψ(J_f) (+ penalty) over y, x = red.expand(y), starting from *y. Steps are
+// limited to keep every triangle with positive orientation positive (Smith & Schaefer 2015) and
+// accepted by Armijo backtracking. Uses core::SparseSolver, or a dense Cholesky for small problems.
+OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
+                               const OptimizeSettings& settings, Eigen::VectorXd* y);
+
+// Per-face densities ψ(J_f) of the layout x (2·#copies); +inf for a barrier density at a flip.
+Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd& x,
+                               Density density, double power);
+
+// Jacobian of face f (rest frame → UV) in the layout x.
+Eigen::Matrix2d face_jacobian(const LayoutDomain& domain, int f, const Eigen::VectorXd& x);
+
+}  // namespace quadify::param
+
+namespace quadify::param {
+
+struct TransitionReport {
+  core::Status status;
+  Reduction reduction;   // of the new constraint set
+  int iterations = 0;
+  int n_flipped = 0;     // flipped faces after the move (exact predicate); 0 on success
+};
+
+// Moves the layout *x (which satisfies the constraints of `old_red`) into the constraint space of
+// `elim` (old rows + `new_rows`) without flips: minimises SD + w·weight_unit·Σ(row·x)² inside the
+// old space for increasing w until the new rows are nearly satisfied, then projects (least
+// squares) onto the new space and checks orientations exactly; continues with larger w while
+// faces are flipped. weight_unit makes w dimensionless (area / Σ edge length²).
+TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
+                                       const ConstraintEliminator& elim,
+                                       const std::vector<SparseRow>& new_rows, double weight_unit,
+                                       Eigen::VectorXd* x);
+
+// Faces with non-positive orientation of their three copies in x (exact predicate).
+int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x);
+
+}  // namespace quadify::param

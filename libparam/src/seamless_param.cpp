@@ -1,0 +1,339 @@
+#include <libparam/seamless_param.h>
+
+#include "constraint_elimination.h"
+#include "cut_layout.h"
+#include "layout_optimizer.h"
+#include "local_estimation.h"
+
+#include <libcore/predicates.h>
+#include <libcore/sparse_solver.h>
+#include <libcore/topology.h>
+
+#ifdef QUADIFY_WITH_TBB
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#endif
+
+#include <chrono>
+#include <climits>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace quadify::param {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Relative tolerance of the Newton stops for the batch layouts (fraction of the energy).
+constexpr double kBatchTolerance = 1e-7;
+// Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau.
+constexpr double kTauPowers[] = {2, 4, 8, 16};
+// Exponent of the L^p ARAP energy for Energy::kLinfArap.
+constexpr double kLinfArapPower = 8;
+
+struct ComponentOutput {
+  core::Status status;
+  Eigen::MatrixX2d corner_uv;
+  std::vector<SeamMatching> seams;  // component-local face and vertex ids
+  std::vector<ConeInfo> cones;
+  ParamStats stats;
+};
+
+double batch_threshold(const ParamOptions& o, int i) {
+  return o.order == RoundingOrder::kBottomUp ? o.threshold_step * (i + 1)
+                                             : 0.5 - o.threshold_step * (i + 1);
+}
+
+ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options) {
+  ComponentOutput out;
+  const auto t0 = Clock::now();
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  const LayoutDomain domain = make_domain(cut);
+  const int n_vars = 2 * cut.n_copies();
+  const Eigen::MatrixX2d x2 = isometric_unfold(mesh, cut);
+  Eigen::VectorXd x(n_vars);
+  for (int c = 0; c < cut.n_copies(); ++c) x.segment<2>(2 * c) = x2.row(c).transpose();
+  out.stats.seconds_cut = seconds_since(t0);
+  out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
+
+  std::vector<char> gauge(n_vars, 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator elim(n_vars, gauge);
+  Reduction red = elim.reduction(x);
+  const int n_seams = static_cast<int>(cut.seams.size());
+  std::vector<int> matching(n_seams, INT_MIN);  // INT_MIN: not rounded yet
+  double total_area = 0;
+  for (double a : cut.area) total_area += a;
+
+  Density density = Density::kSymmetricDirichlet;
+  double power = 1;
+  if (options.energy == Energy::kArap) density = Density::kArap;
+  if (options.energy == Energy::kLinfArap) {
+    density = Density::kPowerArap;
+    power = kLinfArapPower;
+  }
+  if (options.energy == Energy::kConformal) density = Density::kMips;
+
+  const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels);
+  const int n_steps =
+      static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
+  for (int step = 0; step < n_steps; ++step) {
+    if (options.progress) options.progress("round", step, n_steps);
+    const double eps = batch_threshold(options, step);
+    const bool last = step + 1 == n_steps;
+    Eigen::MatrixX2d xm(cut.n_copies(), 2);
+    for (int c = 0; c < cut.n_copies(); ++c) xm.row(c) = x.segment<2>(2 * c).transpose();
+    const std::vector<double> m = measure_matchings(cut, xm);
+    std::vector<int> batch;
+    for (int s = 0; s < n_seams; ++s) {
+      if (matching[s] != INT_MIN) continue;
+      const double err = std::abs(m[s] - std::round(m[s]));
+      const bool take = options.order == RoundingOrder::kBottomUp ? (last || err < eps)
+                                                                  : (last || err > eps);
+      if (take) batch.push_back(s);
+    }
+    if (batch.empty()) continue;
+    // Local estimation of the uncertain ones (patches independent: parallel, deterministic).
+    std::vector<int> chosen(batch.size());
+    std::vector<int> uncertain;
+    for (size_t i = 0; i < batch.size(); ++i) {
+      const double ms = m[batch[i]];
+      chosen[i] = static_cast<int>(std::lround(ms));
+      if (options.local_estimation &&
+          std::abs(ms - std::round(ms)) >= options.local_estimation_min_error)
+        uncertain.push_back(static_cast<int>(i));
+    }
+    if (!uncertain.empty()) {
+      const auto tl = Clock::now();
+      std::vector<PatchChoice> choices(uncertain.size());
+      auto work = [&](size_t u) {
+        const int s = batch[uncertain[u]];
+        choices[u] = estimator.choose(s, m[s], matching, x, density, power);
+      };
+#ifdef QUADIFY_WITH_TBB
+      tbb::parallel_for(size_t(0), uncertain.size(), work);
+#else
+      for (size_t u = 0; u < uncertain.size(); ++u) work(u);
+#endif
+      for (size_t u = 0; u < uncertain.size(); ++u) {
+        ++out.stats.n_patches;
+        if (choices[u].matching != chosen[uncertain[u]]) ++out.stats.n_improved;
+        chosen[uncertain[u]] = choices[u].matching;
+      }
+      out.stats.seconds_local_estimation += seconds_since(tl);
+    }
+    const auto to = Clock::now();
+    std::vector<SparseRow> new_rows;
+    double edge_sq = 0;
+    for (size_t i = 0; i < batch.size(); ++i) {
+      const int s = batch[i];
+      matching[s] = chosen[i];
+      for (const SparseRow& row : seam_constraint_rows(cut, s, chosen[i])) {
+        elim.add_row(row);
+        new_rows.push_back(row);
+      }
+      edge_sq += cut.rest[cut.seams[s].he_a / 3].col(0).squaredNorm();
+    }
+    ++out.stats.n_batches;
+    TransitionReport tr = move_into_constraints(domain, red, elim, new_rows,
+                                                total_area / std::max(edge_sq, 1e-300), &x);
+    out.stats.total_iterations += tr.iterations;
+    red = std::move(tr.reduction);
+    if (!tr.status.is_ok()) {
+      out.status = tr.status;
+    }
+    Eigen::VectorXd y = red.restrict(x);
+    OptimizeSettings st;
+    st.density = density;
+    st.power = power;
+    st.max_iterations = options.max_newton_iters;
+    st.relative_tolerance = kBatchTolerance;
+    const OptimizeReport rep = optimize_layout(domain, red, st, &y);
+    out.stats.total_iterations += rep.iterations;
+    if (rep.status.is_ok()) x = red.expand(y);
+    out.stats.seconds_optimize += seconds_since(to);
+  }
+  if (options.energy == Energy::kTau) {
+    const auto to = Clock::now();
+    for (double p : kTauPowers) {
+      if (options.progress) options.progress("tau", static_cast<int>(p), 16);
+      Eigen::VectorXd y = red.restrict(x);
+      OptimizeSettings st;
+      st.density = Density::kPowerSD;
+      st.power = p;
+      st.max_iterations = options.max_newton_iters;
+      st.relative_tolerance = kBatchTolerance;
+      const OptimizeReport rep = optimize_layout(domain, red, st, &y);
+      out.stats.total_iterations += rep.iterations;
+      if (rep.status.is_ok() && std::isfinite(rep.energy)) x = red.expand(y);
+    }
+    out.stats.seconds_optimize += seconds_since(to);
+  }
+
+  // Output: corner UVs, seams, cones, metrics.
+  const int nf = mesh.n_faces();
+  out.corner_uv.resize(3 * nf, 2);
+  for (int c = 0; c < 3 * nf; ++c) out.corner_uv.row(c) = x.segment<2>(2 * cut.corner_copy[c]).transpose();
+  for (int s = 0; s < n_seams; ++s) {
+    const CutSeam& cs = cut.seams[s];
+    const int fa = cs.he_a / 3, ka = cs.he_a % 3;
+    const int r = ((matching[s] % 4) + 4) % 4;
+    out.seams.push_back({fa, cs.he_b / 3, mesh.F(fa, ka), mesh.F(fa, (ka + 1) % 3), r});
+    for (const SparseRow& row : seam_constraint_rows(cut, s, r)) {
+      double v = 0;
+      for (const auto& [var, coef] : row.entries) v += coef * x[var];
+      out.stats.seam_residual = std::max(out.stats.seam_residual, std::abs(v));
+    }
+  }
+  // Flips (exact) and τ.
+  double s1max = 0, s2min = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < nf; ++f) {
+    const Eigen::Vector2d a = out.corner_uv.row(3 * f), b = out.corner_uv.row(3 * f + 1),
+                          c = out.corner_uv.row(3 * f + 2);
+    if (core::orient2d(a, b, c) <= 0) ++out.stats.n_flipped;
+    const Eigen::Matrix2d J = face_jacobian(domain, f, x);
+    const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+    const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+    s1max = std::max(s1max, 0.5 * (ps + pa));
+    s2min = std::min(s2min, 0.5 * (ps - pa));
+    const double sd =
+        evaluate_density(Density::kSymmetricDirichlet, 1, J, false, false).value;
+    out.stats.sd_max = std::max(out.stats.sd_max, sd);
+  }
+  out.stats.tau = out.stats.n_flipped > 0 || !(s2min > 0)
+                      ? std::numeric_limits<double>::infinity()
+                      : std::sqrt(s1max / s2min);
+  // Cones: UV angle sums at interior vertices.
+  std::vector<double> angle_sum(mesh.n_vertices(), 0.0);
+  std::vector<char> on_boundary(mesh.n_vertices(), 0);
+  for (int h = 0; h < 3 * nf; ++h)
+    if (cut.topo.twin[h] < 0) on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d p = out.corner_uv.row(3 * f + k);
+      const Eigen::Vector2d u = Eigen::Vector2d(out.corner_uv.row(3 * f + (k + 1) % 3)) - p;
+      const Eigen::Vector2d w = Eigen::Vector2d(out.corner_uv.row(3 * f + (k + 2) % 3)) - p;
+      angle_sum[mesh.F(f, k)] += std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w));
+    }
+  for (int v = 0; v < mesh.n_vertices(); ++v) {
+    if (on_boundary[v] || angle_sum[v] == 0) continue;
+    const int index = 4 - static_cast<int>(std::lround(angle_sum[v] / (0.5 * std::numbers::pi)));
+    if (index != 0) out.cones.push_back({v, index});
+  }
+  out.stats.n_cones = static_cast<int>(out.cones.size());
+  if (out.status.is_ok() && out.stats.n_flipped > 0)
+    out.status = core::Status::not_converged("seamless layout has " +
+                                             std::to_string(out.stats.n_flipped) + " flipped faces");
+  return out;
+}
+
+core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
+  if (!(o.threshold_step > 0 && o.threshold_step <= 0.5))
+    return core::Status::invalid_input("threshold_step must be in (0, 0.5]");
+  if (o.patch_bfs_levels < 1) return core::Status::invalid_input("patch_bfs_levels must be >= 1");
+  if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
+  if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
+  if (mesh.n_faces() == 0) return core::Status::invalid_input("mesh has no faces");
+  if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) < 0 || mesh.F(f, k) >= mesh.n_vertices())
+        return core::Status::invalid_input("face " + std::to_string(f) + " has a vertex index out of range");
+    if (core::collinear3d(mesh.V.row(mesh.F(f, 0)), mesh.V.row(mesh.F(f, 1)), mesh.V.row(mesh.F(f, 2))))
+      return core::Status::invalid_input("face " + std::to_string(f) + " is degenerate (zero area)");
+  }
+  const core::TopologyStats ts = core::topology_stats(mesh);
+  if (!ts.is_manifold())
+    return core::Status::invalid_input("mesh is not manifold (" + std::to_string(ts.n_nonmanifold_edges) +
+                                       " edges, " + std::to_string(ts.n_nonmanifold_vertices) + " vertices)");
+  return core::Status::ok();
+}
+
+}  // namespace
+
+ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions& options) {
+  ParamResult result;
+  const auto t0 = Clock::now();
+  result.uv.mesh = mesh;
+  result.status = validate(mesh, options);
+  if (!result.status.is_ok()) return result;
+  core::EdgeTopology topo;
+  try {
+    topo = core::build_edge_topology(mesh);
+  } catch (const std::invalid_argument& e) {
+    result.status = core::Status::invalid_input(e.what());
+    return result;
+  }
+  std::vector<int> component;
+  const int n_comp = core::face_components(mesh, topo, &component);
+  // Component sub-meshes with local vertex ids.
+  std::vector<core::TriMesh> sub(n_comp);
+  std::vector<std::vector<int>> sub_faces(n_comp), sub_vertices(n_comp);
+  std::vector<int> local_vertex(mesh.n_vertices(), -1);
+  for (int f = 0; f < mesh.n_faces(); ++f) sub_faces[component[f]].push_back(f);
+  for (int c = 0; c < n_comp; ++c) {
+    auto& sm = sub[c];
+    sm.F.resize(sub_faces[c].size(), 3);
+    for (size_t i = 0; i < sub_faces[c].size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const int v = mesh.F(sub_faces[c][i], k);
+        if (local_vertex[v] < 0) {
+          local_vertex[v] = static_cast<int>(sub_vertices[c].size());
+          sub_vertices[c].push_back(v);
+        }
+        sm.F(i, k) = local_vertex[v];
+      }
+    sm.V.resize(sub_vertices[c].size(), 3);
+    for (size_t i = 0; i < sub_vertices[c].size(); ++i) sm.V.row(i) = mesh.V.row(sub_vertices[c][i]);
+  }
+  std::vector<ComponentOutput> outs(n_comp);
+  auto work = [&](int c) { outs[c] = run_component(sub[c], options); };
+#ifdef QUADIFY_WITH_TBB
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] { tbb::parallel_for(0, n_comp, work); });
+#else
+  for (int c = 0; c < n_comp; ++c) work(c);
+#endif
+  // Deterministic merge in component order.
+  result.uv.corner_uv.resize(3 * mesh.n_faces(), 2);
+  auto& st = result.stats;
+  st.n_components = n_comp;
+  st.tau = 0;
+  for (int c = 0; c < n_comp; ++c) {
+    const ComponentOutput& o = outs[c];
+    if (!o.status.is_ok() && result.status.is_ok()) result.status = o.status;
+    for (size_t i = 0; i < sub_faces[c].size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        result.uv.corner_uv.row(3 * sub_faces[c][i] + k) = o.corner_uv.row(3 * i + k);
+    for (const SeamMatching& s : o.seams)
+      result.seams.push_back({sub_faces[c][s.face_a], sub_faces[c][s.face_b],
+                              sub_vertices[c][s.edge_vertex0], sub_vertices[c][s.edge_vertex1],
+                              s.matching});
+    for (const ConeInfo& k : o.cones) result.cones.push_back({sub_vertices[c][k.vertex], k.index});
+    st.n_seam_edges += o.stats.n_seam_edges;
+    st.n_cones += o.stats.n_cones;
+    st.n_patches += o.stats.n_patches;
+    st.n_improved += o.stats.n_improved;
+    st.n_batches = std::max(st.n_batches, o.stats.n_batches);
+    st.total_iterations += o.stats.total_iterations;
+    st.n_flipped += o.stats.n_flipped;
+    st.tau = std::max(st.tau, o.stats.tau);
+    st.sd_max = std::max(st.sd_max, o.stats.sd_max);
+    st.seam_residual = std::max(st.seam_residual, o.stats.seam_residual);
+    st.seconds_cut += o.stats.seconds_cut;
+    st.seconds_optimize += o.stats.seconds_optimize;
+    st.seconds_local_estimation += o.stats.seconds_local_estimation;
+  }
+  const double diag = core::bbox_diagonal(mesh.V);
+  if (result.status.is_ok() && st.seam_residual > options.seam_tol * diag)
+    result.status = core::Status::not_converged("seam residual " + std::to_string(st.seam_residual) +
+                                                " above tolerance");
+  st.seconds_total = seconds_since(t0);
+  return result;
+}
+
+}  // namespace quadify::param

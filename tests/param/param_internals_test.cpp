@@ -1,0 +1,212 @@
+// Unit tests of libparam internals: cut + isometric unfold, matching measurement, constraint
+// elimination, energy derivatives, the layout optimizer and local estimation.
+#include "constraint_elimination.h"
+#include "cut_layout.h"
+#include "distortion_energy.h"
+#include "layout_optimizer.h"
+#include "local_estimation.h"
+
+#include <libcore/predicates.h>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include <climits>
+#include <cmath>
+#include <numbers>
+
+#include "test_meshes.h"
+
+namespace quadify::param {
+namespace {
+
+Eigen::VectorXd flatten(const Eigen::MatrixX2d& x) {
+  Eigen::VectorXd v(2 * x.rows());
+  for (Eigen::Index i = 0; i < x.rows(); ++i) v.segment<2>(2 * i) = x.row(i).transpose();
+  return v;
+}
+
+// Singular values of J via the similarity/anti-similarity split (σ2 signed).
+std::pair<double, double> singular_values(const Eigen::Matrix2d& J) {
+  const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+  const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+  return {0.5 * (ps + pa), 0.5 * (ps - pa)};
+}
+
+TEST(CutLayout, DualTreeCutIsADiskWithFPlus2Copies) {
+  const core::TriMesh m = test::make_icosphere(2);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  EXPECT_EQ(cut.n_copies(), m.n_faces() + 2) << "a tree of triangles has F+2 vertices";
+  EXPECT_EQ(static_cast<int>(cut.seams.size()), cut.topo.n_edges() - (m.n_faces() - 1));
+}
+
+TEST(CutLayout, IsometricUnfoldHasUnitSingularValues) {
+  for (const core::TriMesh& m : {test::make_icosphere(2), test::make_torus(20, 8), test::make_disk(5, 12)}) {
+    const CutMesh cut = cut_along_dual_tree(m, 0);
+    const LayoutDomain dom = make_domain(cut);
+    const Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
+    // Round-off of the face-by-face layout accumulates slowly; 1e-9 is far above it.
+    constexpr double kIsometryTol = 1e-9;
+    double worst = 0;
+    for (int f = 0; f < m.n_faces(); ++f) {
+      const auto [s1, s2] = singular_values(face_jacobian(dom, f, x));
+      worst = std::max({worst, std::abs(s1 - 1), std::abs(s2 - 1)});
+    }
+    EXPECT_LT(worst, kIsometryTol) << "max |σ−1| over faces";
+    EXPECT_EQ(count_flipped(dom, x), 0);
+  }
+}
+
+TEST(CutLayout, MatchingOfAFlatSquareIsZeroAndOfACubeCornerIsAQuarter) {
+  // Flat: two triangles sharing every edge through a tree… use a flat disk: all seams match 0.
+  core::TriMesh flat = test::make_disk(3, 8);
+  flat.V.col(2).setZero();
+  const CutMesh cut = cut_along_dual_tree(flat, 0);
+  const auto m = measure_matchings(cut, isometric_unfold(flat, cut));
+  for (double v : m) EXPECT_NEAR(v, 0.0, 1e-12) << "flat disk seams are untwisted";
+  // The three faces around a cube corner: angle defect π/2, so the one seam matches ±1.
+  core::TriMesh corner;
+  corner.V.resize(4, 3);
+  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  corner.F.resize(3, 3);
+  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const CutMesh cc = cut_along_dual_tree(corner, 0);
+  ASSERT_EQ(cc.seams.size(), 1u);
+  const auto mc = measure_matchings(cc, isometric_unfold(corner, cc));
+  EXPECT_NEAR(std::abs(mc[0]), 1.0, 1e-12) << "cube corner: a quarter turn, got " << mc[0];
+}
+
+TEST(ConstraintElimination, ResidualIsZeroAndRedundantRowsAreDropped) {
+  const core::TriMesh m = test::make_icosphere(2);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  const Eigen::VectorXd x0 = flatten(isometric_unfold(m, cut));
+  std::vector<char> gauge(x0.size(), 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator elim(static_cast<int>(x0.size()), gauge);
+  const auto meas = measure_matchings(cut, isometric_unfold(m, cut));
+  std::vector<SparseRow> rows;
+  for (size_t s = 0; s < cut.seams.size(); ++s)
+    for (const auto& r : seam_constraint_rows(cut, static_cast<int>(s), std::lround(meas[s])))
+      rows.push_back(r);
+  int independent = 0;
+  for (const auto& r : rows) independent += elim.add_row(r);
+  EXPECT_EQ(independent, elim.rank());
+  // Sphere: 2·#seams = F+2 rows, all independent (the cut disk has F+2 copies and the closure of
+  // its boundary is not implied by the matchings); so F free scalars remain besides the gauge.
+  EXPECT_EQ(elim.rank(), m.n_faces() + 2);
+  // Adding all rows again: all redundant.
+  for (const auto& r : rows) EXPECT_FALSE(elim.add_row(r));
+  const Reduction red = elim.reduction(x0);
+  EXPECT_EQ(red.n_free(), static_cast<int>(x0.size()) - elim.rank() - 2);
+  // Any y gives an exactly seamless x (integer coefficients).
+  Eigen::VectorXd y = Eigen::VectorXd::LinSpaced(red.n_free(), -1.0, 2.0);
+  const Eigen::VectorXd x = red.expand(y);
+  double worst = 0;
+  for (const auto& r : rows) {
+    double v = 0;
+    for (const auto& [var, c] : r.entries) v += c * x[var];
+    worst = std::max(worst, std::abs(v));
+  }
+  EXPECT_LT(worst, 1e-12) << "constraint residual of P·y + c";
+  // The gauge copy keeps its position.
+  EXPECT_EQ(x[2 * cut.root_copy], x0[2 * cut.root_copy]);
+  EXPECT_LE(elim.max_expression_length(), red.n_free());
+}
+
+TEST(DistortionEnergy, DerivativesMatchFiniteDifferences) {
+  const Eigen::Matrix2d J = (Eigen::Matrix2d() << 1.3, 0.2, -0.4, 0.9).finished();
+  const std::pair<Density, double> kinds[] = {{Density::kSymmetricDirichlet, 1},
+                                              {Density::kPowerSD, 3},
+                                              {Density::kArap, 1},
+                                              {Density::kPowerArap, 8},
+                                              {Density::kMips, 1}};
+  constexpr double kStep = 1e-6;    // central differences: error O(h²)
+  constexpr double kRelTol = 1e-5;  // relative to the derivative magnitude
+  for (const auto& [kind, p] : kinds) {
+    const DensityEval ev = evaluate_density(kind, p, J, true, false);
+    for (int i = 0; i < 4; ++i) {
+      Eigen::Matrix2d Jp = J, Jm = J;
+      Jp(i / 2, i % 2) += kStep;
+      Jm(i / 2, i % 2) -= kStep;
+      const DensityEval ep = evaluate_density(kind, p, Jp, true, false);
+      const DensityEval em = evaluate_density(kind, p, Jm, true, false);
+      const double fd = (ep.value - em.value) / (2 * kStep);
+      EXPECT_NEAR(ev.gradient[i], fd, kRelTol * (1 + std::abs(fd))) << "kind " << int(kind) << " i " << i;
+      const Eigen::Vector4d hfd = (ep.gradient - em.gradient) / (2 * kStep);
+      for (int j = 0; j < 4; ++j)
+        EXPECT_NEAR(ev.hessian(j, i), hfd[j], kRelTol * (1 + hfd.norm()))
+            << "kind " << int(kind) << " H(" << j << "," << i << ")";
+    }
+    const DensityEval pr = evaluate_density(kind, p, J, true, true);
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(pr.hessian);
+    EXPECT_GE(es.eigenvalues().minCoeff(), -1e-10) << "projected Hessian must be PSD";
+  }
+  EXPECT_NEAR(evaluate_density(Density::kSymmetricDirichlet, 1, Eigen::Matrix2d::Identity(), false, false).value, 4, 1e-15);
+  EXPECT_FALSE(evaluate_density(Density::kSymmetricDirichlet, 1, Eigen::Vector2d(1, -1).asDiagonal().toDenseMatrix(), false, false).finite);
+}
+
+TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
+  const core::TriMesh m = test::make_icosphere(2);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  const LayoutDomain dom = make_domain(cut);
+  Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
+  std::vector<char> gauge(x.size(), 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator elim(static_cast<int>(x.size()), gauge);
+  const Reduction red0 = elim.reduction(x);
+  Eigen::MatrixX2d xm = isometric_unfold(m, cut);
+  const auto meas = measure_matchings(cut, xm);
+  std::vector<SparseRow> rows;
+  double edge_sq = 0, area = 0;
+  for (size_t s = 0; s < cut.seams.size(); ++s) {
+    for (const auto& r : seam_constraint_rows(cut, static_cast<int>(s), std::lround(meas[s]))) {
+      elim.add_row(r);
+      rows.push_back(r);
+    }
+    edge_sq += cut.rest[cut.seams[s].he_a / 3].col(0).squaredNorm();
+  }
+  for (double a : cut.area) area += a;
+  TransitionReport tr = move_into_constraints(dom, red0, elim, rows, area / edge_sq, &x);
+  ASSERT_TRUE(tr.status.is_ok()) << tr.status.to_string();
+  Eigen::VectorXd y = tr.reduction.restrict(x);
+  OptimizeSettings st;
+  const OptimizeReport rep = optimize_layout(dom, tr.reduction, st, &y);
+  ASSERT_TRUE(rep.status.is_ok()) << rep.status.to_string();
+  EXPECT_LE(rep.energy, rep.initial_energy);
+  x = tr.reduction.expand(y);
+  EXPECT_EQ(count_flipped(dom, x), 0);
+  double worst = 0;
+  for (const auto& r : rows) {
+    double v = 0;
+    for (const auto& [var, c] : r.entries) v += c * x[var];
+    worst = std::max(worst, std::abs(v));
+  }
+  EXPECT_LT(worst, 1e-12);
+}
+
+TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
+  // Cube corner (defect π/2): the seam measures ±1 exactly. Perturb the layout so that the measure
+  // is ambiguous is not needed: ask for a choice given a measure of 0.5 (between 0 and 1 in the
+  // direction of the true rotation); the side equal to the true rotation yields a flat, lower
+  // distortion patch.
+  core::TriMesh corner;
+  corner.V.resize(4, 3);
+  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  corner.F.resize(3, 3);
+  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const CutMesh cut = cut_along_dual_tree(corner, 0);
+  const LayoutDomain dom = make_domain(cut);
+  const Eigen::VectorXd x = flatten(isometric_unfold(corner, cut));
+  const double truth = measure_matchings(cut, isometric_unfold(corner, cut))[0];
+  const LocalEstimator est(corner, cut, dom, 2);
+  const std::vector<int> rounded(cut.seams.size(), INT_MIN);
+  const double ambiguous = truth > 0 ? 0.5 : -0.5;
+  const PatchChoice pc = est.choose(0, ambiguous, rounded, x, Density::kSymmetricDirichlet, 1);
+  EXPECT_EQ(pc.matching, std::lround(truth))
+      << "distortions floor " << pc.distortion[0] << " ceil " << pc.distortion[1];
+  EXPECT_LT(std::min(pc.distortion[0], pc.distortion[1]), 4 * 1.5 + 1e-9);
+  EXPECT_EQ(pc.n_faces, 3);
+}
+
+}  // namespace
+}  // namespace quadify::param

@@ -1,0 +1,46 @@
+// End-to-end runs on the shared benchmark meshes (skipped when the folder is absent). Prints the
+// measured τ, cones, flips and seconds; asserts flip-free, seamless, Gauss–Bonnet.
+#include <libparam/seamless_param.h>
+
+#include <libcore/read_mesh.h>
+#include <libcore/topology.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "test_util.h"
+
+namespace quadify::param {
+namespace {
+
+void run_benchmark(const std::string& file, Energy energy = Energy::kTau) {
+  const auto dir = test::shared_meshes_dir();
+  if (dir.empty()) GTEST_SKIP() << "no shared meshes";
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(dir / file));
+  ParamOptions o;
+  o.energy = energy;
+  const ParamResult r = compute_seamless_param(mesh, o);
+  const auto& s = r.stats;
+  int cone_sum = 0;
+  for (const auto& c : r.cones) cone_sum += c.index;
+  std::printf("[param] %s F=%d tau=%.4f sdmax=%.3f cones=%d flips=%d resid=%.2e patches=%d improved=%d "
+              "iters=%d cut=%.2fs opt=%.2fs le=%.2fs total=%.2fs status=%s\n",
+              file.c_str(), mesh.n_faces(), s.tau, s.sd_max, s.n_cones, s.n_flipped, s.seam_residual,
+              s.n_patches, s.n_improved, s.total_iterations, s.seconds_cut, s.seconds_optimize,
+              s.seconds_local_estimation, s.seconds_total, r.status.to_string().c_str());
+  EXPECT_TRUE(r.status.is_ok()) << file << ": " << r.status.to_string();
+  EXPECT_EQ(s.n_flipped, 0) << file;
+  EXPECT_LE(s.seam_residual, o.seam_tol * core::bbox_diagonal(mesh.V)) << file;
+  const auto ts = core::topology_stats(mesh);
+  if (ts.n_boundary_loops == 0) EXPECT_EQ(cone_sum, 4 * ts.euler_characteristic) << file;
+}
+
+TEST(SeamlessParamBenchmark, Spot) { run_benchmark("spot.obj"); }
+TEST(SeamlessParamBenchmark, Knot1) { run_benchmark("knot1.obj"); }
+TEST(SeamlessParamBenchmark, Fertility) { run_benchmark("fertility.obj"); }
+TEST(SeamlessParamBenchmark, Fandisk) { run_benchmark("fandisk.obj"); }
+TEST(SeamlessParamBenchmark, Armadillo) { run_benchmark("armadillo.obj"); }
+
+}  // namespace
+}  // namespace quadify::param

@@ -1,0 +1,143 @@
+// End-to-end tests of compute_seamless_param on procedural and tests/data meshes: zero flips
+// (exact predicate), seam residual ≤ seam_tol × bbox diagonal, integer matchings, cone indices
+// satisfying Gauss–Bonnet (Σ index = 4χ in quarter turns).
+#include <libparam/seamless_param.h>
+
+#include <libcore/predicates.h>
+#include <libcore/read_mesh.h>
+#include <libcore/topology.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "test_meshes.h"
+#include "test_util.h"
+
+namespace quadify::param {
+namespace {
+
+// Seam residual bound of the API contract, relative to the bbox diagonal.
+constexpr double kSeamTol = 1e-9;
+
+struct Checked {
+  int flips = 0;
+  int cone_sum = 0;
+  double residual = 0;
+};
+
+// Recomputes the properties from the output alone (independently of ParamStats).
+Checked check_result(const std::string& name, const core::TriMesh& mesh, const ParamResult& r) {
+  Checked c;
+  EXPECT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+  const auto& uv = r.uv.corner_uv;
+  EXPECT_EQ(uv.rows(), 3 * mesh.n_faces()) << name;
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    if (core::orient2d(uv.row(3 * f), uv.row(3 * f + 1), uv.row(3 * f + 2)) <= 0) ++c.flips;
+  auto corner_of = [&](int f, int v) {
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) == v) return 3 * f + k;
+    return -1;
+  };
+  for (const SeamMatching& s : r.seams) {
+    EXPECT_GE(s.matching, 0) << name;
+    EXPECT_LE(s.matching, 3) << name;
+    const Eigen::Vector2d ea =
+        uv.row(corner_of(s.face_a, s.edge_vertex1)) - uv.row(corner_of(s.face_a, s.edge_vertex0));
+    const Eigen::Vector2d eb =
+        uv.row(corner_of(s.face_b, s.edge_vertex1)) - uv.row(corner_of(s.face_b, s.edge_vertex0));
+    Eigen::Vector2d re = ea;
+    for (int i = 0; i < s.matching; ++i) re = Eigen::Vector2d(-re.y(), re.x());
+    c.residual = std::max(c.residual, (eb - re).norm());
+  }
+  for (const ConeInfo& k : r.cones) c.cone_sum += k.index;
+  EXPECT_EQ(c.flips, 0) << name << ": flipped faces";
+  EXPECT_LE(c.residual, kSeamTol * core::bbox_diagonal(mesh.V)) << name << ": seam residual";
+  EXPECT_EQ(r.stats.n_flipped, c.flips) << name;
+  return c;
+}
+
+ParamOptions fast_options(Energy e = Energy::kSymmetricDirichlet) {
+  ParamOptions o;
+  o.energy = e;
+  return o;
+}
+
+TEST(SeamlessParam, SphereConesSumToEight) {
+  const core::TriMesh mesh = test::make_icosphere(2);
+  const ParamResult r = compute_seamless_param(mesh, fast_options());
+  const Checked c = check_result("icosphere2", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8) << "icosphere: Σ cone index (quarter turns) must be 4χ = 8";
+  EXPECT_GT(r.stats.n_cones, 0);
+  EXPECT_EQ(r.stats.n_flipped, 0);
+}
+
+TEST(SeamlessParam, TorusConesSumToZero) {
+  const core::TriMesh mesh = test::make_torus(24, 10);
+  const ParamResult r = compute_seamless_param(mesh, fast_options());
+  const Checked c = check_result("torus", mesh, r);
+  EXPECT_EQ(c.cone_sum, 0) << "torus: Σ cone index must be 4χ = 0";
+}
+
+TEST(SeamlessParam, OpenDiskIsFlipFreeAndSeamless) {
+  const core::TriMesh mesh = test::make_disk(8, 24);
+  const ParamResult r = compute_seamless_param(mesh, fast_options());
+  check_result("disk", mesh, r);
+}
+
+TEST(SeamlessParam, TauEnergyReportsTau) {
+  const core::TriMesh mesh = test::make_icosphere(2);
+  const ParamResult r = compute_seamless_param(mesh, fast_options(Energy::kTau));
+  check_result("icosphere2/tau", mesh, r);
+  EXPECT_GE(r.stats.tau, 1.0);
+  EXPECT_LT(r.stats.tau, 3.0) << "τ of a subdivided icosahedron should be moderate";
+}
+
+TEST(SeamlessParam, TwoComponentsAreDeterministicAcrossThreadCounts) {
+  core::TriMesh a = test::make_icosphere(1), b = test::make_torus(16, 8);
+  core::TriMesh m;
+  m.V.resize(a.V.rows() + b.V.rows(), 3);
+  m.V << a.V, b.V;
+  m.F.resize(a.F.rows() + b.F.rows(), 3);
+  m.F << a.F, (b.F.array() + static_cast<int>(a.V.rows())).matrix();
+  ParamOptions o1 = fast_options(), o2 = fast_options();
+  o1.threads = 1;
+  o2.threads = 2;
+  const ParamResult r1 = compute_seamless_param(m, o1), r2 = compute_seamless_param(m, o2);
+  const Checked c = check_result("sphere+torus", m, r1);
+  EXPECT_EQ(c.cone_sum, 8) << "sphere + torus: 4χ = 8";
+  EXPECT_EQ(r1.stats.n_components, 2);
+  EXPECT_TRUE(r1.uv.corner_uv == r2.uv.corner_uv) << "result depends on the thread count";
+}
+
+TEST(SeamlessParam, RejectsDegenerateFace) {
+  core::TriMesh m = test::make_icosphere(0);
+  m.V.row(m.F(0, 2)) = 0.5 * (m.V.row(m.F(0, 0)) + m.V.row(m.F(0, 1)));
+  const ParamResult r = compute_seamless_param(m);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+}
+
+TEST(SeamlessParam, RejectsBadOptions) {
+  ParamOptions o;
+  o.threshold_step = 0;
+  const ParamResult r = compute_seamless_param(test::make_icosphere(0), o);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput);
+}
+
+TEST(SeamlessParam, TestDataMeshes) {
+  for (const char* name : {"tet.obj", "cube.obj", "sphere.obj", "disk.obj", "torus.obj"}) {
+    const auto path = test::data_path(name);
+    if (!std::filesystem::exists(path)) continue;
+    const core::TriMesh mesh = core::to_trimesh(core::read_mesh(path));
+    const ParamResult r = compute_seamless_param(mesh, fast_options());
+    const Checked c = check_result(name, mesh, r);
+    const int chi = core::topology_stats(mesh).euler_characteristic;
+    const int n_boundary = core::topology_stats(mesh).n_boundary_loops;
+    if (n_boundary == 0) {
+      EXPECT_EQ(c.cone_sum, 4 * chi) << name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace quadify::param
