@@ -110,6 +110,33 @@ TEST(ReadMesh, GltfAndGlbWithNodeTransforms) {
   }
 }
 
+TEST(ReadMesh, GltfNonIndexedFanAndMatrixNode) {
+  // A unit square as a non-indexed TRIANGLE_FAN, under a node matrix translating by (0, 0, 5).
+  std::string buffer;
+  const float square[4][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  for (const auto& p : square)
+    for (float x : p) put<float>(&buffer, x, false);
+  const std::string json = R"({"asset":{"version":"2.0"},"scenes":[{"nodes":[0]}],
+    "nodes":[{"matrix":[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,5,1],"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"mode":6}]}],
+    "buffers":[{"byteLength":48,"uri":"data:application/octet-stream;base64,)" + base64(buffer) + R"("}],
+    "bufferViews":[{"buffer":0,"byteLength":48}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}]})";
+  PolyMesh m;
+  try {
+    m = read_mesh_from_memory(json, MeshFormat::kGltf, "fan.gltf");
+  } catch (const InputError& e) {
+    if (std::string(e.what()).find("QUADIFY_WITH_GLTF=OFF") != std::string::npos) GTEST_SKIP();
+    FAIL() << e.what();
+  }
+  ASSERT_EQ(m.n_faces(), 2);
+  ASSERT_EQ(m.n_vertices(), 4);
+  for (int v = 0; v < 4; ++v) EXPECT_DOUBLE_EQ(m.V(v, 2), 5.0) << "v" << v;
+  EXPECT_EQ(m.vertex(1, 0), 0);  // fan: (0,1,2), (0,2,3)
+  EXPECT_EQ(m.vertex(1, 1), 2);
+  EXPECT_EQ(m.vertex(1, 2), 3);
+}
+
 TEST(ReadMesh, FilesOnDiskAndDataMeshes) {
   const fs::path dir = test::make_temp_dir("read_mesh");
   ASSERT_FALSE(dir.empty());
