@@ -267,6 +267,28 @@ double xy_area(const core::PolyMesh& m, int f) {
   return 0.5 * a;
 }
 
+// Moves every triangle to its own chart: uv ↦ R_90^r uv + t with random r and integer t per
+// face, so that every interior edge becomes a seam with a random transition.
+void scramble_charts(UVMesh& m, unsigned seed) {
+  std::mt19937 rng(seed);
+  for (int f = 0; f < m.mesh.n_faces(); ++f) {
+    const int r = static_cast<int>(rng() % 4);
+    const Eigen::Vector2d t(static_cast<int>(rng() % 11) - 5, static_cast<int>(rng() % 11) - 5);
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector2d p = m.corner_uv.row(3 * f + k);
+      for (int i = 0; i < r; ++i) p = Eigen::Vector2d(-p.y(), p.x());
+      m.corner_uv.row(3 * f + k) = p + t;
+    }
+  }
+}
+
+// Adds independent noise of magnitude ≤ amplitude to every corner UV (seams stay within tolerance).
+void add_uv_noise(UVMesh& m, double amplitude, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> noise(-amplitude, amplitude);
+  for (int c = 0; c < m.corner_uv.rows(); ++c) m.corner_uv.row(c) += Eigen::Vector2d(noise(rng), noise(rng));
+}
+
 void expect_all_quads(const ExtractResult& r, int n_quads, const std::string& name) {
   ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
   EXPECT_EQ(r.quads.n_faces(), n_quads) << name;
@@ -399,15 +421,69 @@ TEST(ExtractQuads, BoundaryCrossingIsoLinesMakeBoundaryVertices) {
     EXPECT_EQ(c.euler, 1) << name;
     EXPECT_EQ(c.n_boundary_edges, 16) << name;
     EXPECT_EQ(c.n_used_vertices, 32) << name;
-    double total = 0, min_area = 1e300;
+    double total = 0, min_area = 1e300, max_uv_area_error = 0;
     for (int f = 0; f < r.quads.n_faces(); ++f) {
       total += xy_area(r.quads, f);
       min_area = std::min(min_area, xy_area(r.quads, f));
+      // The face's UVs (one chart per face) must span the same area as its positions.
+      double uv_area = 0;
+      for (int k = 0; k < r.quads.degree(f); ++k) {
+        const Eigen::Vector2d a = r.quads.uv.row(r.quads.face_uv[r.quads.face_corner(f, k)]);
+        const Eigen::Vector2d b =
+            r.quads.uv.row(r.quads.face_uv[r.quads.face_corner(f, (k + 1) % r.quads.degree(f))]);
+        uv_area += 0.5 * (a.x() * b.y() - b.x() * a.y());
+      }
+      max_uv_area_error = std::max(max_uv_area_error, std::abs(uv_area - xy_area(r.quads, f)));
     }
+    EXPECT_LT(max_uv_area_error, 1e-9) << name << ": face UVs not in one consistent chart";
     // The domain minus the four corners cut off by the first iso-lines: 16 - 2·0.175 - 2·0.075.
     EXPECT_NEAR(total, 15.5, 1e-9) << name;
     EXPECT_GT(min_area, 0.07) << name << ": a face is inverted or degenerate";
   }
+}
+
+TEST(ExtractQuads, EveryTriangleInItsOwnChart) {
+  for (unsigned seed = 1; seed <= 3; ++seed) {
+    const std::string tag = " (seed " + std::to_string(seed) + ")";
+    UVMesh planar = planar_grid(7, 4.0, 2.0, seed);
+    scramble_charts(planar, seed);
+    const ExtractResult p = extract_quads(planar);
+    expect_all_quads(p, 64, "scrambled planar" + tag);
+    expect_planar_lattice(p.quads, 4, 2.0, "scrambled planar" + tag);
+    EXPECT_EQ(check_poly(p.quads).n_bad_edges, 0);
+
+    UVMesh box = cube(3, 2);
+    scramble_charts(box, seed);
+    const ExtractResult c = extract_quads(box);
+    expect_all_quads(c, 24, "scrambled cube" + tag);
+    EXPECT_EQ(c.stats.n_cones, 8) << tag;
+    PolyCheck pc = check_poly(c.quads);
+    EXPECT_EQ(pc.euler, 2) << tag;
+    EXPECT_EQ(pc.valences[3], 8) << tag;
+
+    UVMesh cut = planar_grid(6, 4.0, 1.0, seed);
+    for (int i = 0; i < cut.corner_uv.rows(); ++i) cut.corner_uv.row(i) += Eigen::Vector2d(0.5, 0.3);
+    scramble_charts(cut, seed);
+    const ExtractResult b = extract_quads(cut);
+    ASSERT_TRUE(b.status.is_ok()) << b.status.to_string() << tag;
+    EXPECT_EQ(b.quads.n_faces(), 25) << tag;
+    EXPECT_EQ(b.stats.n_non_quads, 4) << tag;
+    EXPECT_EQ(check_poly(b.quads).euler, 1) << tag;
+  }
+}
+
+TEST(ExtractQuads, ToleratesSeamNoiseBelowTolerance) {
+  // Noise of 1e-12 UV units per corner: seams, cones and on-vertex grid points are snapped.
+  UVMesh box = cube(3, 3);  // every grid point on a mesh vertex, iso-lines along mesh edges
+  add_uv_noise(box, 1e-12, 4);
+  const ExtractResult c = extract_quads(box);
+  expect_all_quads(c, 54, "noisy cube");
+  EXPECT_EQ(c.stats.n_grid_points_on_vertices, 56);
+  EXPECT_GT(c.stats.max_transition_residual, 0);
+  EXPECT_LT(c.stats.max_transition_residual, 1e-11);
+  PolyCheck pc = check_poly(c.quads);
+  EXPECT_EQ(pc.euler, 2);
+  EXPECT_EQ(pc.valences[3], 8);
 }
 
 TEST(ExtractQuads, RejectsNonSeamlessMap) {
