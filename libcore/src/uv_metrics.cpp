@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
+#include <string>
 
 namespace quadify::core {
 namespace {
@@ -53,6 +55,9 @@ UVMetrics compute_uv_metrics(const UVMesh& uv_mesh, const UVMetricsOptions& opti
   const TriMesh& mesh = uv_mesh.mesh;
   const Eigen::MatrixX2d& uv = uv_mesh.corner_uv;
   const int nf = mesh.n_faces(), nv = mesh.n_vertices();
+  if (uv.rows() != 3 * nf || uv.cols() != 2)
+    throw std::invalid_argument("compute_uv_metrics: corner_uv is " + std::to_string(uv.rows()) + "x" +
+                                std::to_string(uv.cols()) + ", expected (3*" + std::to_string(nf) + ")x2");
   UVMetrics m;
   m.n_faces = nf;
   m.singular_values.setZero(nf, 2);

@@ -8,6 +8,7 @@
 #include <functional>
 #include <numbers>
 #include <queue>
+#include <stdexcept>
 
 namespace quadify::core {
 namespace {
@@ -241,6 +242,12 @@ TEST(UVMetrics, NonIntegerSeamIsReported) {
   EXPECT_FALSE(m.matchings_integer);
   EXPECT_GT(m.seam_residual_max, 0.1);
   EXPECT_LT(m.gauss_bonnet_error, kExactTol);  // angle sums are unchanged by a rigid motion
+}
+
+TEST(UVMetrics, WrongCornerUVSizeThrows) {
+  UVMesh grid = grid_map(2, [](double x, double y) { return Eigen::Vector2d(x, y); });
+  grid.corner_uv.conservativeResize(grid.corner_uv.rows() - 1, 2);
+  EXPECT_THROW((void)compute_uv_metrics(grid), std::invalid_argument);
 }
 
 TEST(UVMetrics, LargeGridIsFast) {

@@ -65,7 +65,11 @@ struct UVMetrics {
   double uv_bbox_diagonal = 0;
 };
 
-// Precondition: mesh manifold and consistently oriented, corner_uv (#F·3)×2 finite.
+// Precondition: mesh manifold and consistently oriented, corner_uv (#F·3)×2 finite. Throws
+// std::invalid_argument (naming the edge, or the sizes) when the mesh is not edge-manifold or not
+// consistently oriented (see build_edge_topology) or corner_uv has the wrong size. O(#F).
+// Corner angles are signed by the exact face orientation, so each flipped triangle adds 2π to
+// gauss_bonnet_error.
 UVMetrics compute_uv_metrics(const UVMesh& uv_mesh, const UVMetricsOptions& options = {});
 
 }  // namespace quadify::core

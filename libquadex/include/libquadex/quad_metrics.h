@@ -31,7 +31,9 @@ struct QuadMetrics {
   int n_boundary_loops = 0;
   int euler_characteristic = 0;
   int genus = -1;           // -1 when not manifold or not orientable
-  int n_flipped = 0;        // quads with a corner of scaled Jacobian ≤ 0 (or facing against the reference)
+  // Quads with a corner of scaled Jacobian ≤ 0, or (with a reference) whose area vector has a
+  // negative dot product with the normal of the reference triangle closest to the quad centroid.
+  int n_flipped = 0;
   // Scaled Jacobian of the quad corners: minimum over all corners, and mean over quads of each
   // quad's minimum corner (the peers' definition).
   double sj_min = 0, sj_mean = 0;
@@ -46,12 +48,15 @@ struct QuadMetrics {
   double hausdorff_sym = -1;
   double mean_dist_sym = -1;
   // Feature capture (reference has sharp edges): share of the sharp-edge length within tolerance
-  // of a quad edge; -1 when the reference has no sharp edges.
+  // of a quad edge; -1 when the reference has no sharp edges or is not manifold and consistently
+  // oriented. Sharp edges are sampled every 1e-3 × diagonal.
   double feature_capture = -1;
   double feature_hausdorff = -1;  // max distance from sharp-edge samples to the nearest quad edge
 };
 
 // Precondition: V finite and face ids in range (any PolyMesh from read_mesh satisfies it).
+// Distances use CGAL AABB trees; sampling is deterministic (options.seed), queries run in
+// parallel with TBB when built with QUADIFY_WITH_TBB.
 QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMesh* reference = nullptr,
                                  const QuadMetricsOptions& options = {});
 
