@@ -7,6 +7,11 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 
+#ifdef QUADIFY_WITH_TBB
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#endif
+
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -16,7 +21,7 @@ namespace quadify::param {
 namespace {
 
 // Problems with at most this many reduced variables use a dense Cholesky (local patches).
-constexpr int kDenseMaxVariables = 600;
+constexpr int kDenseMaxVariables = 250;
 // Fraction of the largest flip-free step actually taken, so triangles keep a positive area.
 constexpr double kFlipFreeStepFraction = 0.8;
 // Armijo sufficient-decrease constant and the number of halvings before giving up.
@@ -24,6 +29,8 @@ constexpr double kArmijo = 1e-4;
 constexpr int kMaxBacktracks = 40;
 // Diagonal shift relative to the mean Hessian diagonal: removes the global-rotation null space.
 constexpr double kRegularization = 1e-9;
+// Below this many faces the per-face evaluation runs serially (patches; thread overhead).
+constexpr int kParallelMinFaces = 2048;
 
 // One element of the energy: local scalar variables, mapped to reduced variables by M (dense
 // n_local × n_reduced, rows = P rows), the reduced ids, and the offsets of its Hessian entries.
@@ -67,6 +74,9 @@ struct Problem {
   bool dense = false;
   Eigen::SparseMatrix<double> H;           // pattern (sparse mode)
   Eigen::MatrixXd Hd;                      // dense mode
+  std::vector<double> face_value;          // per-face buffers of evaluate()
+  std::vector<Eigen::VectorXd> face_gy;
+  std::vector<Eigen::MatrixXd> face_hy;
 
   Problem(const LayoutDomain& d, const Reduction& r, const OptimizeSettings& st)
       : domain(d), red(r), s(st) {
@@ -128,9 +138,7 @@ struct Problem {
       else
         std::fill(H.valuePtr(), H.valuePtr() + H.nonZeros(), 0.0);
     }
-    auto scatter = [&](const Element& el, const Eigen::VectorXd& gl, const Eigen::MatrixXd& hl) {
-      const Eigen::VectorXd gy = el.M.transpose() * gl;
-      const Eigen::MatrixXd hy = el.M.transpose() * hl * el.M;
+    auto scatter = [&](const Element& el, const Eigen::VectorXd& gy, const Eigen::MatrixXd& hy) {
       const size_t k = el.ys.size();
       for (size_t i = 0; i < k; ++i) (*g)[el.ys[i]] += gy[i];
       if (dense) {
@@ -142,9 +150,15 @@ struct Problem {
           for (size_t i = 0; i < k; ++i) vals[el.offsets[j * k + i]] += hy(i, j);
       }
     };
-    Eigen::VectorXd g6(6);
-    Eigen::MatrixXd h6(6, 6);
-    for (int f = 0; f < domain.n_faces(); ++f) {
+    // Per-face work in parallel into per-face slots; sums and scatter in face order, so the
+    // result does not depend on the number of threads.
+    const int nf = domain.n_faces();
+    face_value.resize(nf);
+    if (derivatives) {
+      face_gy.resize(nf);
+      face_hy.resize(nf);
+    }
+    auto face_work = [&](int f) {
       const auto& fc = domain.face_copies[f];
       Eigen::Matrix2d X;
       for (int d = 0; d < 2; ++d) {
@@ -153,28 +167,46 @@ struct Problem {
       }
       const Eigen::Matrix2d J = X * domain.rest_inverse[f];
       const DensityEval ev = evaluate_density(s.density, s.power, J, derivatives, true);
-      if (!ev.finite) return std::numeric_limits<double>::infinity();
       const double a = domain.area[f];
-      energy += a * ev.value;
-      if (!derivatives) continue;
+      face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
+      if (!derivatives || !ev.finite) return;
       // B (4×6): vec(J) index 2d+r, local variable 2k+d, entry G(k, r).
       const Eigen::Matrix<double, 3, 2> G = basis_gradients(domain.rest_inverse[f]);
       Eigen::Matrix<double, 4, 6> B = Eigen::Matrix<double, 4, 6>::Zero();
       for (int k = 0; k < 3; ++k)
         for (int d = 0; d < 2; ++d)
           for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * k + d) = G(k, r);
-      g6 = a * B.transpose() * ev.gradient;
-      h6 = a * B.transpose() * ev.hessian * B;
-      scatter(faces[f], g6, h6);
+      const Eigen::Matrix<double, 6, 1> g6 = a * B.transpose() * ev.gradient;
+      const Eigen::Matrix<double, 6, 6> h6 = a * B.transpose() * ev.hessian * B;
+      const Element& el = faces[f];
+      face_gy[f].noalias() = el.M.transpose() * g6;
+      face_hy[f].noalias() = el.M.transpose() * h6 * el.M;
+    };
+#ifdef QUADIFY_WITH_TBB
+    if (nf >= kParallelMinFaces)
+      tbb::parallel_for(tbb::blocked_range<int>(0, nf, 256), [&](const tbb::blocked_range<int>& r) {
+        for (int f = r.begin(); f < r.end(); ++f) face_work(f);
+      });
+    else
+      for (int f = 0; f < nf; ++f) face_work(f);
+#else
+    for (int f = 0; f < nf; ++f) face_work(f);
+#endif
+    for (int f = 0; f < nf; ++f) {
+      energy += face_value[f];
+      if (!std::isfinite(face_value[f])) return std::numeric_limits<double>::infinity();
     }
+    if (derivatives)
+      for (int f = 0; f < nf; ++f) scatter(faces[f], face_gy[f], face_hy[f]);
     for (size_t i = 0; i < rows.size(); ++i) {
       const Eigen::VectorXd& co = row_coefs[i];
       double rv = 0;
       for (Eigen::Index j = 0; j < co.size(); ++j) rv += co[j] * x[(*s.penalty_rows)[i].entries[j].first];
       energy += s.penalty_weight * rv * rv;
       if (!derivatives) continue;
-      scatter(rows[i], 2 * s.penalty_weight * rv * co,
-              2 * s.penalty_weight * co * co.transpose());
+      const Element& el = rows[i];
+      scatter(el, el.M.transpose() * (2 * s.penalty_weight * rv * co),
+              el.M.transpose() * (2 * s.penalty_weight * co * co.transpose()) * el.M);
     }
     return energy;
   }
@@ -333,9 +365,9 @@ namespace quadify::param {
 namespace {
 
 // Penalty weights tried (dimensionless, see move_into_constraints), in increasing order.
-constexpr double kFirstPenalty = 10, kPenaltyGrowth = 10, kLastPenalty = 1e10;
+constexpr double kFirstPenalty = 100, kPenaltyGrowth = 10, kLastPenalty = 1e10;
 // Newton iterations per penalty stage.
-constexpr int kPenaltyIterations = 30;
+constexpr int kPenaltyIterations = 15;
 // Projection is attempted once every new row's residual is below this fraction of the mean
 // seam edge length (the projection then moves vertices by about as much).
 constexpr double kProjectResidual = 1e-3;
@@ -384,7 +416,19 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   Eigen::VectorXd x_cur = *x;
   Eigen::VectorXd x_best;
   int best_flips = INT32_MAX;
-  for (double w = kFirstPenalty; w <= kLastPenalty; w *= kPenaltyGrowth) {
+  // Cheapest first: the least-squares projection of the current layout (usually flip-free when
+  // the new matchings are close to the measured rotations).
+  {
+    core::Status ps;
+    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps);
+    if (!ps.is_ok()) {
+      rep.status = ps;
+      return rep;
+    }
+    x_best = rep.reduction.expand(y_new);
+    best_flips = count_flipped(domain, x_best);
+  }
+  for (double w = kFirstPenalty; w <= kLastPenalty && best_flips > 0; w *= kPenaltyGrowth) {
     if (max_residual(x_cur) > residual_tol) {
       OptimizeSettings st;
       st.max_iterations = kPenaltyIterations;

@@ -15,6 +15,8 @@
 #endif
 
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <climits>
 #include <cmath>
 #include <numbers>
@@ -28,8 +30,10 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-// Relative tolerance of the Newton stops for the batch layouts (fraction of the energy).
-constexpr double kBatchTolerance = 1e-7;
+// Relative tolerance of the Newton stops (fraction of the energy): intermediate batches only
+// steer the next matchings, the final layouts are converged further.
+constexpr double kBatchTolerance = 1e-5;
+constexpr double kFinalTolerance = 1e-8;
 // Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau.
 constexpr double kTauPowers[] = {2, 4, 8, 16};
 // Exponent of the L^p ARAP energy for Energy::kLinfArap.
@@ -143,6 +147,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                                                 total_area / std::max(edge_sq, 1e-300), &x);
     out.stats.total_iterations += tr.iterations;
     red = std::move(tr.reduction);
+    if (std::getenv("QUADIFY_PARAM_DEBUG"))
+      std::fprintf(stderr, "batch %d: %zu rows rank %d free %d maxexpr %d nnzP %ld transition iters %d %.2fs\n", step,
+                   new_rows.size(), elim.rank(), red.n_free(), elim.max_expression_length(),
+                   (long)red.P.nonZeros(), tr.iterations, seconds_since(to));
     if (!tr.status.is_ok()) {
       out.status = tr.status;
     }
@@ -151,7 +159,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     st.density = density;
     st.power = power;
     st.max_iterations = options.max_newton_iters;
-    st.relative_tolerance = kBatchTolerance;
+    st.relative_tolerance = last ? kFinalTolerance : kBatchTolerance;
     const OptimizeReport rep = optimize_layout(domain, red, st, &y);
     out.stats.total_iterations += rep.iterations;
     if (rep.status.is_ok()) x = red.expand(y);
@@ -166,7 +174,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.density = Density::kPowerSD;
       st.power = p;
       st.max_iterations = options.max_newton_iters;
-      st.relative_tolerance = kBatchTolerance;
+      st.relative_tolerance = kFinalTolerance;
       const OptimizeReport rep = optimize_layout(domain, red, st, &y);
       out.stats.total_iterations += rep.iterations;
       if (rep.status.is_ok() && std::isfinite(rep.energy)) x = red.expand(y);
