@@ -565,7 +565,9 @@ class Extractor {
     const BoundaryEvent& lu = x.axis == 0 ? x : y;
     const BoundaryEvent& lv = x.axis == 0 ? y : x;
     int o = core::orient2d(a, b, Eigen::Vector2d(lu.value, lv.value));
-    if (o == 0) o = -lu.sigma * sv + lv.sigma * su;  // degenerate: the offsets decide
+    // P on the edge's line: the offsets decide, sign of cross(b - a, (σ_u, σ_v)). The
+    // differences are exact on the dyadic UV grid, so the comparison is exact too.
+    if (o == 0) o = sign((b.x() - a.x()) * lv.sigma, (b.y() - a.y()) * lu.sigma);
     const bool u_first = su * sv * o > 0;
     return (x.axis == 0) == u_first;
   }

@@ -289,6 +289,39 @@ void add_uv_noise(UVMesh& m, double amplitude, unsigned seed) {
   for (int c = 0; c < m.corner_uv.rows(); ++c) m.corner_uv.row(c) += Eigen::Vector2d(noise(rng), noise(rng));
 }
 
+// A disk of radius 1: centre plus `rings` rings of `sectors` vertices, UV = scale·(x,y) + offset.
+UVMesh polar_disk(int rings, int sectors, double scale, Eigen::Vector2d offset) {
+  UVMesh m;
+  m.mesh.V.resize(1 + rings * sectors, 3);
+  m.mesh.V.row(0) << 0, 0, 0;
+  for (int i = 1; i <= rings; ++i)
+    for (int j = 0; j < sectors; ++j) {
+      const double r = double(i) / rings, phi = 2 * M_PI * (j + 0.5 * (i % 2)) / sectors;
+      m.mesh.V.row(1 + (i - 1) * sectors + j) << r * std::cos(phi), r * std::sin(phi), 0;
+    }
+  std::vector<std::array<int, 3>> tris;
+  for (int j = 0; j < sectors; ++j) tris.push_back({0, 1 + j, 1 + (j + 1) % sectors});
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < sectors; ++j) {
+      const int a = 1 + (i - 1) * sectors + j, b = 1 + (i - 1) * sectors + (j + 1) % sectors;
+      const int c = 1 + i * sectors + j, d = 1 + i * sectors + (j + 1) % sectors;
+      // Odd rings are rotated by half a sector: pick the diagonal that keeps triangles CCW.
+      if (i % 2) {
+        tris.push_back({a, d, b}), tris.push_back({a, c, d});
+      } else {
+        tris.push_back({a, c, b}), tris.push_back({b, c, d});
+      }
+    }
+  m.mesh.F.resize(static_cast<int>(tris.size()), 3);
+  m.corner_uv.resize(3 * static_cast<int>(tris.size()), 2);
+  for (size_t f = 0; f < tris.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      m.mesh.F(f, k) = tris[f][k];
+      m.corner_uv.row(3 * f + k) = scale * m.mesh.V.row(tris[f][k]).head<2>().transpose() + offset;
+    }
+  return m;
+}
+
 void expect_all_quads(const ExtractResult& r, int n_quads, const std::string& name) {
   ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
   EXPECT_EQ(r.quads.n_faces(), n_quads) << name;
@@ -484,6 +517,37 @@ TEST(ExtractQuads, ToleratesSeamNoiseBelowTolerance) {
   PolyCheck pc = check_poly(c.quads);
   EXPECT_EQ(pc.euler, 2);
   EXPECT_EQ(pc.valences[3], 8);
+}
+
+TEST(ExtractQuads, RoundDiskBoundaryCutsCells) {
+  int case_id = 0;
+  for (const double scale : {3.7, 6.0, 10.3})
+    for (const Eigen::Vector2d& offset : {Eigen::Vector2d(0.25, 0.61), Eigen::Vector2d(0, 0)}) {
+      const std::string name = "disk case " + std::to_string(case_id++);
+      UVMesh map = polar_disk(5, 24, scale, offset);
+      scramble_charts(map, 17 + case_id);
+      const ExtractResult r = extract_quads(map);
+      ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+      EXPECT_EQ(r.stats.n_dropped_faces, 0) << name;
+      PolyCheck c = check_poly(r.quads);
+      EXPECT_EQ(c.n_bad_edges, 0) << name;
+      EXPECT_EQ(c.euler, 1) << name;
+      EXPECT_EQ(c.n_used_vertices, r.quads.n_vertices()) << name << ": unused vertices";
+      // Every lattice point strictly inside the disk is a vertex of valence 4.
+      const double radius = scale * std::cos(M_PI / 24);  // inscribed circle of the polygon
+      int inner = 0;
+      for (int x = -20; x <= 20; ++x)
+        for (int y = -20; y <= 20; ++y)
+          inner += std::hypot(x - offset.x(), y - offset.y()) < radius - 1e-9;
+      EXPECT_GE(c.valences[4], inner) << name;
+      double min_area = 1e300;
+      for (int f = 0; f < r.quads.n_faces(); ++f) min_area = std::min(min_area, xy_area(r.quads, f));
+      EXPECT_GT(min_area, 0) << name << ": an output face is inverted or degenerate";
+      EXPECT_GE(c.n_boundary_edges, r.stats.n_boundary_crossings) << name;
+      const core::TopologyStats t = core::topology_stats(core::to_trimesh(r.quads));
+      EXPECT_TRUE(t.is_manifold()) << name;
+      EXPECT_EQ(t.n_boundary_loops, 1) << name;
+    }
 }
 
 TEST(ExtractQuads, RejectsNonSeamlessMap) {
