@@ -6,6 +6,7 @@
 #include <libcore/predicates.h>
 #include <libcore/read_mesh.h>
 #include <libcore/topology.h>
+#include <libcore/uv_metrics.h>
 
 #include <gtest/gtest.h>
 
@@ -19,6 +20,8 @@ namespace {
 
 // Seam residual bound of the API contract, relative to the bbox diagonal.
 constexpr double kSeamTol = 1e-9;
+// Gauss–Bonnet error of the UV angle sums (radians): round-off of a few thousand atan2 calls.
+constexpr double kGaussBonnetTol = 1e-6;
 
 struct Checked {
   int flips = 0;
@@ -54,6 +57,16 @@ Checked check_result(const std::string& name, const core::TriMesh& mesh, const P
   EXPECT_EQ(c.flips, 0) << name << ": flipped faces";
   EXPECT_LE(c.residual, kSeamTol * core::bbox_diagonal(mesh.V)) << name << ": seam residual";
   EXPECT_EQ(r.stats.n_flipped, c.flips) << name;
+  // Independent check with core::compute_uv_metrics.
+  const core::UVMetrics um = core::compute_uv_metrics(r.uv);
+  EXPECT_EQ(um.n_flipped, 0) << name;
+  EXPECT_EQ(um.n_degenerate, 0) << name;
+  EXPECT_TRUE(um.matchings_integer) << name;
+  EXPECT_TRUE(um.cone_indices_integer) << name;
+  EXPECT_LT(um.gauss_bonnet_error, kGaussBonnetTol) << name;
+  EXPECT_LE(um.seam_residual_abs, kSeamTol * core::bbox_diagonal(mesh.V)) << name;
+  EXPECT_EQ(um.n_cones, r.stats.n_cones) << name;
+  EXPECT_NEAR(um.tau, r.stats.tau, 1e-9 * r.stats.tau) << name;
   return c;
 }
 
