@@ -243,15 +243,18 @@ void write_gltf(const fs::path& path, const PolyMesh& mesh, const WriteOptions& 
     attributes["TEXCOORD_0"] = accessors.size() - 1;
   }
   Json primitives = Json::array();
-  auto add_primitive = [&](const std::vector<uint32_t>& indices, int mode) {
+  auto add_primitive = [&](const std::vector<uint32_t>& indices, int mode, const Json& prim_attributes) {
     if (indices.empty()) return;
     accessors.push_back({{"bufferView", buffer.add_view(views, indices, kTargetElementArrayBuffer)},
                          {"componentType", kComponentUnsignedInt}, {"count", indices.size()},
                          {"type", "SCALAR"}});
-    primitives.push_back({{"attributes", attributes}, {"indices", accessors.size() - 1}, {"mode", mode}});
+    primitives.push_back({{"attributes", prim_attributes}, {"indices", accessors.size() - 1}, {"mode", mode}});
   };
-  add_primitive(g.triangles, kModeTriangles);
-  add_primitive(g.lines, kModeLines);
+  add_primitive(g.triangles, kModeTriangles, attributes);
+  // The wireframe shares the vertex data; it is never textured, so it leaves out TEXCOORD_0.
+  Json line_attributes = attributes;
+  line_attributes.erase("TEXCOORD_0");
+  add_primitive(g.lines, kModeLines, line_attributes);
 
   const bool glb = is_glb(path);
   const std::string& bin = buffer.bytes();

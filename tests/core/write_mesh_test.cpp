@@ -302,6 +302,8 @@ TEST_F(WriteMeshTest, GltfQuadMeshWithUvsHasSplitVerticesTrianglesAndWireframe) 
     ASSERT_EQ(prims.size(), 2u);
     EXPECT_EQ(prims[0]["mode"], 4);
     EXPECT_EQ(prims[1]["mode"], 1);
+    EXPECT_FALSE(prims[1]["attributes"].contains("TEXCOORD_0"));
+    EXPECT_EQ(prims[1]["attributes"]["POSITION"], prims[0]["attributes"]["POSITION"]);
     const auto& attr = prims[0]["attributes"];
     const int pos = attr["POSITION"], nrm = attr["NORMAL"], tex = attr["TEXCOORD_0"];
     const size_t n_out = distinct_corner.size();
