@@ -172,6 +172,12 @@ class Extractor {
 
   core::Status validate_input() {
     const auto& mesh = map_.mesh;
+    if (!(opt_.max_transition_residual >= 0) || !(opt_.max_cone_offset >= 0) ||
+        !(opt_.integer_snap_tolerance >= 0) || !(opt_.integer_snap_tolerance < 0.5) ||
+        opt_.max_grid_points < 0)
+      return core::Status::invalid_input(
+          "extract_quads: options out of range (tolerances must be ≥ 0, integer_snap_tolerance "
+          "< 0.5, max_grid_points ≥ 0)");
     if (nf_ == 0) return core::Status::invalid_input("extract_quads: the mesh has no faces");
     if (map_.corner_uv.rows() != 3 * nf_)
       return core::Status::invalid_input("extract_quads: corner_uv has " +
@@ -464,6 +470,10 @@ class Extractor {
     }
   }
 
+  // The outgoing quad half-edges ("slots") of every grid point: in each incident face's chart,
+  // the directions d with p + ε·d + ε²·left(d) inside the face. Exactly one face qualifies per
+  // direction at a regular point; a cone of angle kπ/2 gets k slots; at the boundary, only
+  // directions pointing into the mesh (or along it with the mesh on their left) qualify.
   void create_slots() {
     slot_begin_.assign(grid_.size() + 1, 0);
     std::vector<std::pair<int, IVec>> charts;
@@ -683,10 +693,9 @@ class Extractor {
     }
     // Iso-lines arriving at a boundary grid point with no face to their left turn onto the boundary.
     for (const PendingBoundary& pb : pending_boundary_) {
-      const auto [c_face, to_c] = cw_most(pb.face, pb.loc);
+      const Transform to_boundary_chart = cw_most(pb.face, pb.loc).second;
       he_next_[pb.halfedge] = boundary_halfedge(pb.grid);
-      he_to_next_[pb.halfedge] = compose(to_c, pb.acc);
-      (void)c_face;
+      he_to_next_[pb.halfedge] = compose(to_boundary_chart, pb.acc);
     }
     // Boundary half-edges (created on demand; creating one may require the next).
     for (size_t i = 0; i < boundary_work_.size(); ++i) {

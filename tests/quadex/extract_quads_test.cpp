@@ -588,6 +588,18 @@ TEST(ExtractQuads, RejectsBadSizes) {
   EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
 }
 
+TEST(ExtractQuads, RejectsBadOptionsAndTooFineMaps) {
+  const UVMesh map = planar_grid(4, 4.0, 1.0, 2);
+  ExtractOptions bad;
+  bad.max_transition_residual = -1;
+  EXPECT_EQ(extract_quads(map, bad).status.code(), core::StatusCode::kInvalidInput);
+  ExtractOptions small;
+  small.max_grid_points = 10;  // the map spans 25 + points
+  const ExtractResult r = extract_quads(map, small);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+  EXPECT_NE(r.status.message().find("max_grid_points"), std::string::npos) << r.status.message();
+}
+
 TEST(ExtractQuads, LargeTorusSpeed) {
   // 250×200 grid → 100K triangles, 200×100 = 20K quads.
   const UVMesh map = torus(250, 200, 200.0, 100.0);
