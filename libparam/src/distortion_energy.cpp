@@ -85,10 +85,10 @@ DensityEval mips(const Vec4& w, bool derivatives) {
   return r;
 }
 
-// φ(ψ) = (ψ/scale)^e composed with a density.
-DensityEval power(DensityEval base, double scale, double e, bool derivatives) {
+// φ(ψ) = ((ψ + offset)/scale)^e composed with a density.
+DensityEval power(DensityEval base, double offset, double scale, double e, bool derivatives) {
   if (!base.finite) return base;
-  const double u = std::max(base.value / scale, 0.0);
+  const double u = std::max((base.value + offset) / scale, 0.0);
   DensityEval r;
   r.value = std::pow(u, e);
   if (!derivatives) return r;
@@ -107,9 +107,9 @@ DensityEval evaluate_density(Density kind, double p, const Eigen::Matrix2d& J, b
   DensityEval r;
   switch (kind) {
     case Density::kSymmetricDirichlet: r = symmetric_dirichlet(w, derivatives); break;
-    case Density::kPowerSD: r = power(symmetric_dirichlet(w, derivatives), 4.0, p, derivatives); break;
+    case Density::kPowerSD: r = power(symmetric_dirichlet(w, derivatives), 0.0, 4.0, p, derivatives); break;
     case Density::kArap: r = arap(w, derivatives); break;
-    case Density::kPowerArap: r = power(arap(w, derivatives), 1.0, 0.5 * p, derivatives); break;
+    case Density::kPowerArap: r = power(arap(w, derivatives), 1.0, 1.0, 0.5 * p, derivatives); break;
     case Density::kMips: r = mips(w, derivatives); break;
   }
   if (derivatives && project_psd && r.finite) {

@@ -11,7 +11,8 @@ enum class Density {
   kSymmetricDirichlet,  // |J|² + |J⁻¹|²  (4 at an isometry; +inf when det J ≤ 0)
   kPowerSD,             // (SD/4)^p       (L^p continuation towards the max distortion)
   kArap,                // |J − R(J)|² = Σ(σi − 1)² with signed σ2
-  kPowerArap,           // (ARAP)^(p/2)   (L^p ARAP)
+  kPowerArap,           // (1 + ARAP)^(p/2) (L^p ARAP; the offset keeps the Hessian regular
+                        // at an isometry)
   kMips,                // |J|²/det J = σ1/σ2 + σ2/σ1 (+inf when det J ≤ 0)
 };
 

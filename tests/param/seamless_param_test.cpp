@@ -154,3 +154,32 @@ TEST(SeamlessParam, TestDataMeshes) {
 
 }  // namespace
 }  // namespace quadify::param
+
+namespace quadify::param {
+namespace {
+
+// Every energy yields an exactly seamless map with integer matchings; the line search keeps
+// layouts flip-free even for the energies without a barrier.
+TEST(SeamlessParam, AllEnergiesAreSeamless) {
+  const core::TriMesh mesh = test::make_torus(16, 8);
+  for (Energy e : {Energy::kArap, Energy::kLinfArap, Energy::kConformal}) {
+    ParamOptions o;
+    o.energy = e;
+    const ParamResult r = compute_seamless_param(mesh, o);
+    const std::string name = "torus/energy " + std::to_string(static_cast<int>(e));
+    const Checked c = check_result(name, mesh, r);
+    EXPECT_EQ(c.cone_sum, 0) << name;
+  }
+}
+
+TEST(SeamlessParam, TopDownOrderIsSeamless) {
+  const core::TriMesh mesh = test::make_icosphere(1);
+  ParamOptions o = fast_options();
+  o.order = RoundingOrder::kTopDown;
+  const ParamResult r = compute_seamless_param(mesh, o);
+  const Checked c = check_result("icosphere1/top-down", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8);
+}
+
+}  // namespace
+}  // namespace quadify::param
