@@ -11,7 +11,8 @@ namespace quadify::quadex {
 struct ExtractOptions {
   // Largest allowed seam residual, × the UV bounding-box diagonal. Across every interior edge the
   // two sides' UVs must satisfy (u',v') = R_90^r (u,v) + (s,t) with (s,t) ∈ Z²; the residual is
-  // the largest distance of an endpoint from that relation plus the distance of (s,t) from Z².
+  // the largest distance |R^r x + (s,t) − x'| over the edge's two endpoints, with the best-fit r
+  // and the best-fit translation rounded to Z².
   // Above it the map is rejected (kInvalidInput naming the edge). Relative to the UV size
   // because seam errors of a solver scale with the magnitudes it handles.
   double max_transition_residual = 1e-6;
@@ -20,18 +21,19 @@ struct ExtractOptions {
   double max_cone_offset = 1e-6;
   // UV coordinates within this distance (× UV bounding-box diagonal) of an integer are snapped to
   // it, so that vertices meant to lie on an iso-line do exactly (no sliver grid crossings).
-  // All other coordinates are rounded to a dyadic grid fine enough (≥ 2^-40 of a grid unit when
-  // |uv| < 2^8, in general 2^-(50 - log2(4·max|uv|))) that integer transitions act exactly.
+  // All other coordinates are rounded to the dyadic grid 2^-k, k = min(40, 50 − ⌈log2(4·max|uv|
+  // + 4)⌉) (2^-40 for |uv| < 60), on which adding integer translations is exact in double.
   double integer_snap_tolerance = 1e-9;
   // Refuse maps whose UV triangles' bounding boxes hold more integer points than this in total:
   // a too-fine map is a bad input, not a reason to exhaust memory.
   long long max_grid_points = 50'000'000;
-  // Fill quads.uv / quads.face_uv with integer UVs per face corner (one chart per face).
+  // Fill quads.uv / quads.face_uv with UVs per face corner, one chart per face: integer at grid
+  // points, the crossing's UV at boundary crossings.
   bool output_uv = true;
 };
 
 struct ExtractStats {
-  int n_vertices = 0;  // quad-mesh vertices (= grid points)
+  int n_vertices = 0;  // quad-mesh vertices: grid points plus boundary crossings
   int n_faces = 0;
   int n_non_quads = 0;                 // output faces of degree ≠ 4
   int n_grid_points_on_vertices = 0;   // grid points at a triangle-mesh vertex
