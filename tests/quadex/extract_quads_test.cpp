@@ -550,6 +550,45 @@ TEST(ExtractQuads, RoundDiskBoundaryCutsCells) {
     }
 }
 
+TEST(ExtractQuads, RandomSimilarityMapsGiveValidMeshes) {
+  // UV = scale·R_θ·(x,y) + offset on jittered planar grids, every triangle in its own chart:
+  // iso-lines cut the boundary at arbitrary angles, some pass exactly through vertices.
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const std::string name = "similarity trial " + std::to_string(trial);
+    UVMesh map = planar_grid(8, 4.0, 1.0, 100 + trial);
+    const double theta = trial % 4 == 0 ? 0.0 : 2 * M_PI * unit(rng);
+    const double scale = trial % 4 == 0 ? 1.0 + trial / 4 : 0.7 + 2.5 * unit(rng);
+    const Eigen::Vector2d offset = trial % 4 == 0 ? Eigen::Vector2d(0, 0)
+                                                  : Eigen::Vector2d(unit(rng) * 3, unit(rng) * 3);
+    for (int c = 0; c < map.corner_uv.rows(); ++c) {
+      const Eigen::Vector2d p = map.corner_uv.row(c);
+      map.corner_uv.row(c) = scale * Eigen::Vector2d(std::cos(theta) * p.x() - std::sin(theta) * p.y(),
+                                                     std::sin(theta) * p.x() + std::cos(theta) * p.y()) +
+                             offset;
+    }
+    scramble_charts(map, trial);
+    const ExtractResult r = extract_quads(map);
+    ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+    EXPECT_EQ(r.stats.n_dropped_faces, 0) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.n_used_vertices, r.quads.n_vertices()) << name;
+    double total = 0, min_area = 1e300;
+    for (int f = 0; f < r.quads.n_faces(); ++f) {
+      total += xy_area(r.quads, f);
+      min_area = std::min(min_area, xy_area(r.quads, f));
+    }
+    EXPECT_GT(min_area, 0) << name << ": an output face is inverted or degenerate";
+    EXPECT_LE(total, 16.0 + 1e-9) << name;
+    // Only the 4 domain corners are cut off (boundary vertices are the crossings), each within
+    // one UV cell of xy area 1/scale².
+    EXPECT_GE(total, 16.0 - 4.0 / (scale * scale) - 1e-9) << name << ": faces missing";
+  }
+}
+
 TEST(ExtractQuads, RejectsNonSeamlessMap) {
   UVMesh map = planar_grid(6, 4.0, 2.0, 3);
   add_seam(map, 2.1, 1, Eigen::Vector2d(7.3, -3));
