@@ -365,9 +365,9 @@ namespace quadify::param {
 namespace {
 
 // Penalty weights tried (dimensionless, see move_into_constraints), in increasing order.
-constexpr double kFirstPenalty = 100, kPenaltyGrowth = 10, kLastPenalty = 1e10;
+constexpr double kFirstPenalty = 1e3, kPenaltyGrowth = 10, kLastPenalty = 1e10;
 // Newton iterations per penalty stage.
-constexpr int kPenaltyIterations = 15;
+constexpr int kPenaltyIterations = 10;
 // Projection is attempted once every new row's residual is below this fraction of the mean
 // seam edge length (the projection then moves vertices by about as much).
 constexpr double kProjectResidual = 1e-3;

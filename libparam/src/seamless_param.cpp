@@ -15,10 +15,9 @@
 #endif
 
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <climits>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 #include <stdexcept>
 
@@ -147,10 +146,6 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                                                 total_area / std::max(edge_sq, 1e-300), &x);
     out.stats.total_iterations += tr.iterations;
     red = std::move(tr.reduction);
-    if (std::getenv("QUADIFY_PARAM_DEBUG"))
-      std::fprintf(stderr, "batch %d: %zu rows rank %d free %d maxexpr %d nnzP %ld transition iters %d %.2fs\n", step,
-                   new_rows.size(), elim.rank(), red.n_free(), elim.max_expression_length(),
-                   (long)red.P.nonZeros(), tr.iterations, seconds_since(to));
     if (!tr.status.is_ok()) {
       out.status = tr.status;
     }
@@ -299,7 +294,15 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     for (size_t i = 0; i < sub_vertices[c].size(); ++i) sm.V.row(i) = mesh.V.row(sub_vertices[c][i]);
   }
   std::vector<ComponentOutput> outs(n_comp);
-  auto work = [&](int c) { outs[c] = run_component(sub[c], options); };
+  // Components may run on worker threads: serialize the progress callback.
+  ParamOptions component_options = options;
+  std::mutex progress_mutex;
+  if (options.progress)
+    component_options.progress = [&](const std::string& stage, int step, int n_steps) {
+      std::lock_guard<std::mutex> lock(progress_mutex);
+      options.progress(stage, step, n_steps);
+    };
+  auto work = [&](int c) { outs[c] = run_component(sub[c], component_options); };
 #ifdef QUADIFY_WITH_TBB
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(0, n_comp, work); });

@@ -47,8 +47,9 @@ struct ParamOptions {
   // Worker threads for components and local-estimation patches; 0 = all hardware threads.
   // The result does not depend on this number.
   int threads = 0;
-  // Optional progress callback (stage name, step, number of steps); called from the calling
-  // thread only.
+  // Optional progress callback (stage "round": batch step of n_steps; stage "tau": exponent of
+  // the L^p continuation, out of 16). Calls are serialized, but with several components they may
+  // come from worker threads.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
 };
 
