@@ -33,7 +33,9 @@ void run_benchmark(const std::string& file, Energy energy = Energy::kTau) {
   EXPECT_EQ(s.n_flipped, 0) << file;
   EXPECT_LE(s.seam_residual, o.seam_tol * core::bbox_diagonal(mesh.V)) << file;
   const auto ts = core::topology_stats(mesh);
-  if (ts.n_boundary_loops == 0) EXPECT_EQ(cone_sum, 4 * ts.euler_characteristic) << file;
+  if (ts.n_boundary_loops == 0) {
+    EXPECT_EQ(cone_sum, 4 * ts.euler_characteristic) << file;
+  }
 }
 
 TEST(SeamlessParamBenchmark, Spot) { run_benchmark("spot.obj"); }
