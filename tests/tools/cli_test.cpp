@@ -20,7 +20,7 @@ using quadify::test::make_temp_dir;
 
 namespace {
 
-struct Run {
+struct CliRun {
   int exit_code = -1;
   std::string out, err;
 };
@@ -33,11 +33,13 @@ std::string slurp(const fs::path& p) {
 }
 
 // Runs `quadify <args>` with stdout/stderr captured to files of `dir`.
-Run quadify(const std::string& args, const fs::path& dir) {
+CliRun quadify(const std::string& args, const fs::path& dir) {
   const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const std::string cmd = "'" + cli_path() + "' " + args + " >'" + out.string() + "' 2>'" + err.string() + "'";
+  std::string cmd = "'";  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
+  cmd.append(cli_path()).append("' ").append(args).append(" >'").append(out.string());
+  cmd.append("' 2>'").append(err.string()).append("'");
   const int status = std::system(cmd.c_str());
-  Run r;
+  CliRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.out = slurp(out);
   r.err = slurp(err);
@@ -120,26 +122,26 @@ class CliTest : public ::testing::Test {
 };
 
 TEST_F(CliTest, HelpListsCommandsAndExitCodes) {
-  const Run r = quadify("--help", dir_);
+  const CliRun r = quadify("--help", dir_);
   EXPECT_EQ(r.exit_code, 0);
   for (const char* word : {"info", "check", "--json", "--threads", "--quiet", "Exit codes"})
     EXPECT_NE(r.out.find(word), std::string::npos) << "help lacks " << word << ":\n" << r.out;
 }
 
 TEST_F(CliTest, VersionPrintsVersion) {
-  const Run r = quadify("--version", dir_);
+  const CliRun r = quadify("--version", dir_);
   EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("quadify"), std::string::npos);
 }
 
 TEST_F(CliTest, UnknownOptionIsBadInput) {
-  const Run r = quadify("info --no-such-option x.obj", dir_);
+  const CliRun r = quadify("info --no-such-option x.obj", dir_);
   EXPECT_EQ(r.exit_code, 2);
 }
 
 TEST_F(CliTest, InfoReportsTopologyAndRepairs) {
   write_text(dir_ / "cube.obj", kCubeTriObj);
-  const Run r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  const CliRun r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir_ / "r.json"));
   EXPECT_EQ(j["mesh"]["faces"], 12);
@@ -151,7 +153,7 @@ TEST_F(CliTest, InfoReportsTopologyAndRepairs) {
 
 TEST_F(CliTest, MissingFileIsBadInputNamingTheFileWithoutReport) {
   const fs::path missing = dir_ / "does_not_exist.obj";
-  const Run r = quadify("info '" + missing.string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  const CliRun r = quadify("info '" + missing.string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("does_not_exist.obj"), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one error line expected:\n" << r.err;
@@ -163,7 +165,7 @@ TEST_F(CliTest, TruncatedBinaryStlIsBadInput) {
   const unsigned n = 1000;  // announces 1000 triangles, holds none
   bytes.append(reinterpret_cast<const char*>(&n), 4);
   write_text(dir_ / "trunc.stl", bytes);
-  const Run r = quadify("info '" + (dir_ / "trunc.stl").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
+  const CliRun r = quadify("info '" + (dir_ / "trunc.stl").string() + "' --json '" + (dir_ / "r.json").string() + "'", dir_);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("trunc.stl"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "r.json"));
@@ -171,7 +173,7 @@ TEST_F(CliTest, TruncatedBinaryStlIsBadInput) {
 
 TEST_F(CliTest, UnwritableReportIsInternalFailure) {
   write_text(dir_ / "cube.obj", kCubeTriObj);
-  const Run r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "no/such/dir/r.json").string() + "'", dir_);
+  const CliRun r = quadify("info '" + (dir_ / "cube.obj").string() + "' --json '" + (dir_ / "no/such/dir/r.json").string() + "'", dir_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("r.json"), std::string::npos) << r.err;
 }
@@ -179,7 +181,7 @@ TEST_F(CliTest, UnwritableReportIsInternalFailure) {
 TEST_F(CliTest, CheckQuadCubeAgainstTriangleCube) {
   write_text(dir_ / "cube.obj", kCubeTriObj);
   write_text(dir_ / "quads.obj", kCubeQuadObj);
-  const Run r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "cube.obj").string() +
+  const CliRun r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "cube.obj").string() +
                             "' --samples 5000 --json '" + (dir_ / "c.json").string() + "'",
                         dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -197,7 +199,7 @@ TEST_F(CliTest, CheckQuadCubeAgainstTriangleCube) {
 
 TEST_F(CliTest, CheckUvMapOfIsometricStrip) {
   write_text(dir_ / "strip.obj", kStripUvObj);
-  const Run r = quadify("check '" + (dir_ / "strip.obj").string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
+  const CliRun r = quadify("check '" + (dir_ / "strip.obj").string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
   EXPECT_EQ(j["kind"], "uv");
@@ -210,7 +212,7 @@ TEST_F(CliTest, CheckUvMapOfIsometricStrip) {
 
 TEST_F(CliTest, CheckWithMissingReferenceIsBadInput) {
   write_text(dir_ / "quads.obj", kCubeQuadObj);
-  const Run r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "nope.stl").string() + "'", dir_);
+  const CliRun r = quadify("check '" + (dir_ / "quads.obj").string() + "' --reference '" + (dir_ / "nope.stl").string() + "'", dir_);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("nope.stl"), std::string::npos) << r.err;
 }
