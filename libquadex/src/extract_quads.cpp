@@ -27,6 +27,9 @@ constexpr double kMaxUVMagnitude = 67108864.0;  // 2^26 grid units
 // exactly representable (53-bit mantissa, 3 bits of headroom for |t| ≤ 4·max|uv|).
 constexpr int kDyadicMantissaBits = 50;
 constexpr int kMaxDyadicFractionBits = 40;  // finer than any UV noise that matters (2^-40 units)
+// Boundary vertices moved off an iso-line move by 2^this dyadic units (see
+// unsnap_touching_boundary_vertices): far below any geometric scale, exact in double.
+constexpr int kUnsnapDyadicUnitsLog2 = 4;
 // A face cycle longer than this is not a cell of the quad layout but a tracing failure.
 constexpr int kMaxFaceDegree = 1024;
 
@@ -93,8 +96,9 @@ int cross_sign(const Eigen::Vector2d& x, const Eigen::Vector2d& y, int a) {
 
 // Sign of orient2d(x, y, P + ε·kDir[a] + ε²·kDir[b]) for infinitesimal ε > 0 (a ⟂ b). Never 0
 // for a non-degenerate edge: the symbolic perturbation of every traced point.
-int perturbed_orient(const Eigen::Vector2d& x, const Eigen::Vector2d& y, IVec p, int a, int b) {
-  if (const int s = core::orient2d(x, y, to_vec(p))) return s;
+int perturbed_orient(const Eigen::Vector2d& x, const Eigen::Vector2d& y, const Eigen::Vector2d& p,
+                     int a, int b) {
+  if (const int s = core::orient2d(x, y, p)) return s;
   if (const int s = cross_sign(x, y, a)) return s;
   return cross_sign(x, y, b);
 }
@@ -152,6 +156,7 @@ class Extractor {
     if (auto s = validate_input(); !s.is_ok()) return s;
     if (auto s = compute_transitions(); !s.is_ok()) return s;
     if (auto s = build_fans_and_snap(); !s.is_ok()) return s;
+    unsnap_touching_boundary_vertices();
     if (auto s = check_orientation(); !s.is_ok()) return s;
     if (auto s = create_grid_points(); !s.is_ok()) return s;
     create_slots();
@@ -384,10 +389,64 @@ class Extractor {
   }
 
   // Is p + ε·kDir[a] + ε²·kDir[b] strictly inside the UV triangle of f?
-  bool contains(int f, IVec p, int a, int b) const {
+  bool contains(int f, const Eigen::Vector2d& p, int a, int b) const {
     for (int k = 0; k < 3; ++k)
       if (perturbed_orient(uv(f, k), uv(f, (k + 1) % 3), p, a, b) < 0) return false;
     return true;
+  }
+  bool contains(int f, IVec p, int a, int b) const { return contains(f, to_vec(p), a, b); }
+
+  // Is p + ε·kDir[a] + ε²·kDir[b] inside some face of the fan of boundary vertex v (p in the
+  // fan-start chart, directions too)?
+  bool fan_contains(int v, const Eigen::Vector2d& p, int a, int b) const {
+    for (int c = fan_start_[v]; c >= 0; c = ccw_corner(c)) {
+      const Transform& t = corner_chart_[c];
+      if (contains(c / 3, t.apply(p), rot_dir(a, t.r), rot_dir(b, t.r))) return true;
+    }
+    return false;
+  }
+
+  // A boundary vertex exactly on an integer iso-line (one integer coordinate) where the line
+  // continues into the interior on one side and along or into the mesh on the other: tracing
+  // the line from its two ends with opposite symbolic offsets would disagree about where it
+  // touches the boundary and crack the output. Such vertices (typically made by snapping) are
+  // moved off the line by a few dyadic units, towards the side where the mesh surrounds them,
+  // so that the line crosses the boundary right beside them; a side that flips a triangle is
+  // not used.
+  void unsnap_touching_boundary_vertices() {
+    const double delta = std::ldexp(1.0, -std::max(0, dyadic_bits_ - kUnsnapDyadicUnitsLog2));
+    const int nv = map_.mesh.n_vertices();
+    for (int v = 0; v < nv; ++v) {
+      const int c0 = fan_start_[v];
+      if (c0 < 0 || twin_[c0] >= 0) continue;  // unused or interior vertex
+      const Eigen::Vector2d p = uv_[c0];
+      const bool u_int = p.x() == std::round(p.x()), v_int = p.y() == std::round(p.y());
+      if (u_int == v_int) continue;
+      const int d = u_int ? 1 : 0;  // direction of the iso-line through p
+      auto inside_side = [&](int dir, int side) { return fan_contains(v, p, dir, side); };
+      const int left = rot_dir(d, 1), right = rot_dir(d, 3), back = rot_dir(d, 2);
+      const bool fwd_strict = inside_side(d, left) && inside_side(d, right);
+      const bool back_strict = inside_side(back, left) && inside_side(back, right);
+      const bool fwd_any = inside_side(d, left) || inside_side(d, right);
+      const bool back_any = inside_side(back, left) || inside_side(back, right);
+      if (!(fwd_any && back_any && (fwd_strict || back_strict))) continue;
+      // Prefer the side whose half-disk around p lies in the mesh.
+      const bool left_full = inside_side(d, left) && inside_side(left, d) && inside_side(back, left);
+      std::array<int, 2> sides = left_full ? std::array<int, 2>{left, right} : std::array<int, 2>{right, left};
+      for (int side : sides) {
+        const Eigen::Vector2d q = p + delta * to_vec(kDir[side]);
+        bool flips = false;
+        for (int c = c0; c >= 0 && !flips; c = ccw_corner(c)) {
+          const int f = c / 3, k = c % 3;
+          const Eigen::Vector2d qc = corner_chart_[c].apply(q);
+          flips = core::orient2d(k == 0 ? qc : uv(f, 0), k == 1 ? qc : uv(f, 1), k == 2 ? qc : uv(f, 2)) <= 0;
+        }
+        if (flips) continue;
+        for (int c = c0; c >= 0; c = ccw_corner(c)) uv_[c] = corner_chart_[c].apply(q);
+        ++res_.stats.n_unsnapped_boundary_vertices;
+        break;
+      }
+    }
   }
 
   core::Status create_grid_points() {
@@ -672,10 +731,14 @@ class Extractor {
     // grid point; the trace itself continues along the boundary.
     for (const Dangling& dg : dangling) {
       const Slot& sl = slots_[dg.slot];
+      he_to_next_[dg.slot] = dg.acc;
+      he_next_[dg.slot] = boundary_halfedge(dg.event_vertex);
+      const Location loc = locate(sl.face, sl.p);
+      // No reverse when the iso-line runs along the boundary (outside just right of its start).
+      if (locate_cw(sl.face, sl.p, loc, sl.dir, rot_dir(sl.dir, 3)).first < 0) continue;
       const int f_exit = dg.exit_halfedge / 3;
       const int rev = add_halfedge(dg.event_vertex, f_exit, extra_uv_[dg.event_vertex - grid_.size()]);
       reverse_of_vertex_[dg.event_vertex] = rev;
-      const Location loc = locate(sl.face, sl.p);
       // Arriving at the start point along −dir; turn left: direction −(dir+1).
       const auto [g, to_g] = locate_cw(sl.face, sl.p, loc, rot_dir(sl.dir, 3), sl.dir);
       const Transform back = inverse(dg.acc);  // exit chart → start chart
@@ -688,8 +751,6 @@ class Extractor {
       } else {
         pending_boundary_.push_back({rev, sl.grid, sl.face, sl.p, loc, back});
       }
-      he_to_next_[dg.slot] = dg.acc;
-      he_next_[dg.slot] = boundary_halfedge(dg.event_vertex);
     }
     // Iso-lines arriving at a boundary grid point with no face to their left turn onto the boundary.
     for (const PendingBoundary& pb : pending_boundary_) {
@@ -756,7 +817,11 @@ class Extractor {
       if (it != boundary_events_.end() && index + 1 < static_cast<int>(it->second.size())) {
         const BoundaryEvent& ev = it->second[index + 1];
         if (ev.is_line) {
-          he_next_[he] = reverse_of_vertex_.at(ev.vertex);
+          const auto rev = reverse_of_vertex_.find(ev.vertex);
+          if (rev == reverse_of_vertex_.end())
+            return core::Status::internal("extract_quads: the boundary reaches crossing vertex " +
+                                          std::to_string(ev.vertex) + " whose iso-line has no inward half-edge");
+          he_next_[he] = rev->second;
           he_to_next_[he] = acc;
         } else {
           const int slot = ccw_most_slot(ev.vertex, h / 3);

@@ -79,16 +79,16 @@ int count_bad_uv_faces(const core::PolyMesh& m) {
 
 // Triangulated planar grid of (n+1)² vertices over [0,side]², with jittered interior vertices
 // (every other one) and pseudo-random diagonals; position (x,y,0), UV = scale·(x,y).
-UVMesh planar_grid(int n, double side, double scale, unsigned seed) {
+UVMesh planar_grid(int n, double side, double scale, unsigned seed, double jitter_amplitude = 0.3) {
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  std::uniform_real_distribution<double> jitter(-jitter_amplitude, jitter_amplitude);
   UVMesh m;
   m.mesh.V.resize((n + 1) * (n + 1), 3);
   const double h = side / n;
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
       double x = side * i / n, y = side * j / n;
-      if (i > 0 && i < n && j > 0 && j < n && (i + j) % 2 == 1) {
+      if (jitter_amplitude > 0 && i > 0 && i < n && j > 0 && j < n && (i + j) % 2 == 1) {
         x += jitter(rng) * h;
         y += jitter(rng) * h;
       }
@@ -320,6 +320,26 @@ UVMesh polar_disk(int rings, int sectors, double scale, Eigen::Vector2d offset) 
       m.corner_uv.row(3 * f + k) = scale * m.mesh.V.row(tris[f][k]).head<2>().transpose() + offset;
     }
   return m;
+}
+
+// Keeps the faces whose centroid satisfies keep(x, y).
+template <class Keep>
+UVMesh select_faces(const UVMesh& m, Keep keep) {
+  std::vector<int> kept;
+  for (int f = 0; f < m.mesh.n_faces(); ++f) {
+    const Eigen::Vector3d c =
+        (m.mesh.V.row(m.mesh.F(f, 0)) + m.mesh.V.row(m.mesh.F(f, 1)) + m.mesh.V.row(m.mesh.F(f, 2))) / 3;
+    if (keep(c.x(), c.y())) kept.push_back(f);
+  }
+  UVMesh out;
+  out.mesh.V = m.mesh.V;
+  out.mesh.F.resize(static_cast<int>(kept.size()), 3);
+  out.corner_uv.resize(3 * static_cast<int>(kept.size()), 2);
+  for (size_t i = 0; i < kept.size(); ++i) {
+    out.mesh.F.row(i) = m.mesh.F.row(kept[i]);
+    for (int k = 0; k < 3; ++k) out.corner_uv.row(3 * i + k) = m.corner_uv.row(3 * kept[i] + k);
+  }
+  return out;
 }
 
 void expect_all_quads(const ExtractResult& r, int n_quads, const std::string& name) {
@@ -586,6 +606,36 @@ TEST(ExtractQuads, RandomSimilarityMapsGiveValidMeshes) {
     // Only the 4 domain corners are cut off (boundary vertices are the crossings), each within
     // one UV cell of xy area 1/scale².
     EXPECT_GE(total, 16.0 - 4.0 / (scale * scale) - 1e-9) << name << ": faces missing";
+  }
+}
+
+TEST(ExtractQuads, ReflexBoundaryCornerOnAnIsoLine) {
+  // L-shaped domain [0,4]² \ [2,4]², UV = (x + 0.5, y + dy): for dy = 0 the reflex corner
+  // (2,2) ↦ (2.5, 2) lies on the iso-line v = 2, which runs along the boundary on one side of
+  // it and through the interior on the other; dy = 0.5 is the generic control.
+  for (const double dy : {0.0, 0.5}) {
+    const std::string name = "L shape dy=" + std::to_string(dy);
+    UVMesh map = select_faces(planar_grid(8, 4.0, 1.0, 3, 0.0), [](double x, double y) { return x < 2 || y < 2; });
+    for (int c = 0; c < map.corner_uv.rows(); ++c) map.corner_uv.row(c) += Eigen::Vector2d(0.5, dy);
+    const ExtractResult r = extract_quads(map);
+    ASSERT_TRUE(r.status.is_ok()) << name << ": " << r.status.to_string();
+    EXPECT_EQ(r.stats.n_dropped_faces, 0) << name;
+    EXPECT_EQ(r.stats.n_unsnapped_boundary_vertices, dy == 0 ? 1 : 0) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.euler, 1) << name;
+    EXPECT_EQ(c.n_used_vertices, r.quads.n_vertices()) << name;
+    const core::TopologyStats t = core::topology_stats(core::to_trimesh(r.quads));
+    EXPECT_TRUE(t.is_manifold()) << name;
+    EXPECT_EQ(t.n_boundary_loops, 1) << name << ": a crack (T-junction) in the output";
+    double total = 0, min_area = 1e300;
+    for (int f = 0; f < r.quads.n_faces(); ++f) {
+      total += xy_area(r.quads, f);
+      min_area = std::min(min_area, xy_area(r.quads, f));
+    }
+    EXPECT_GT(min_area, 0) << name;
+    EXPECT_LE(total, 12.0 + 1e-9) << name;
+    EXPECT_GE(total, 12.0 - 5 * 0.5 - 1e-9) << name << ": faces missing (5 corners, each ≤ half a cell)";
   }
 }
 

@@ -42,6 +42,9 @@ struct ExtractStats {
   int n_cones = 0;                     // interior vertices whose holonomy is a nonzero rotation
   int n_seam_edges = 0;                // interior edges with a non-identity transition
   int n_boundary_crossings = 0;  // quad vertices where an iso-line crosses the boundary
+  // Boundary vertices lying exactly on an iso-line that touches the boundary there (e.g. a reflex
+  // corner snapped onto it), moved off it by 16 dyadic units so the extraction stays consistent.
+  int n_unsnapped_boundary_vertices = 0;
   int n_dropped_faces = 0;  // half-edge chains that did not close into a face (not expected)
   double max_transition_residual = 0;  // measured, in UV units
   double seconds = 0;
