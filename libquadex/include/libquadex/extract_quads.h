@@ -77,7 +77,10 @@ struct ExtractResult {
 // on the boundary plus the points where an iso-line crosses the boundary (positions interpolated
 // along the boundary edge, non-integer UVs); consecutive ones are joined by a quad edge. A
 // boundary made of iso-line pieces (a boundary-aligned map) thus yields only quads; a boundary
-// cutting through cells yields cut faces of degree ≠ 4, counted in n_non_quads.
+// cutting through cells yields cut faces of degree ≠ 4, counted in n_non_quads. Mesh boundary
+// vertices between crossings are not quad vertices (the corner they make is cut off). A
+// non-integer boundary vertex lying exactly on an iso-line that touches the boundary there
+// (a reflex corner) is first moved off the line by 16 dyadic units (n_unsnapped_boundary_vertices).
 // Returns kOk, kInvalidInput (see above) or kInternal (a tracing invariant failed: a bug).
 [[nodiscard]] ExtractResult extract_quads(const core::UVMesh& map, const ExtractOptions& options = {});
 
