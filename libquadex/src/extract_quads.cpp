@@ -156,8 +156,8 @@ class Extractor {
     if (auto s = validate_input(); !s.is_ok()) return s;
     if (auto s = compute_transitions(); !s.is_ok()) return s;
     if (auto s = build_fans_and_snap(); !s.is_ok()) return s;
-    unsnap_touching_boundary_vertices();
     if (auto s = check_orientation(); !s.is_ok()) return s;
+    unsnap_touching_boundary_vertices();  // keeps every triangle positively oriented
     if (auto s = create_grid_points(); !s.is_ok()) return s;
     create_slots();
     if (auto s = trace_all(); !s.is_ok()) return s;
