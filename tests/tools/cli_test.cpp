@@ -218,3 +218,39 @@ TEST_F(CliTest, CheckWithMissingReferenceIsBadInput) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST_F(CliTest, ParamWritesSeamlessFlipFreeUvObj) {
+  const fs::path out = dir_ / "sphere_uv.obj";
+  const CliRun r = quadify("param '" + data_path("sphere.obj").string() + "' -o '" + out.string() + "' --json '" +
+                               (dir_ / "p.json").string() + "'",
+                           dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  // Measure the written file independently of the param report.
+  const CliRun c = quadify("check '" + out.string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["kind"], "uv");
+  EXPECT_EQ(j["flipped"], 0);
+  EXPECT_EQ(j["matchings_integer"], true);
+  EXPECT_EQ(j["cone_indices_integer"], true);
+  EXPECT_EQ(j["cone_index_sum"], 8) << "sphere: cone indices (quarter turns) sum to 4*chi";
+  EXPECT_LT(j["gauss_bonnet_error"].get<double>(), 1e-9);
+  EXPECT_LT(j["seam_residual_abs"].get<double>(), 1e-9 * 2.0);  // sphere.obj has diagonal ~2√3
+  EXPECT_LT(j["tau"].get<double>(), 3.0);
+}
+
+TEST_F(CliTest, ParamOnBrokenInputWritesNothing) {
+  write_text(dir_ / "bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");  // truncated
+  const fs::path out = dir_ / "out.obj";
+  const CliRun r = quadify("param '" + (dir_ / "bad.off").string() + "' -o '" + out.string() + "'", dir_);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bad.off"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp."), std::string::npos) << entry.path();
+}
+
+}  // namespace

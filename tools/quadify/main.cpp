@@ -1,5 +1,5 @@
-// quadify: triangle mesh → quad mesh. Subcommands: info, check (param and the end-to-end run
-// arrive with their stages). Exit codes: 0 ok, 2 bad input, 1 internal failure.
+// quadify: triangle mesh → quad mesh. Subcommands: info, check, param (the end-to-end run
+// arrives with quantization). Exit codes: 0 ok, 2 bad input, 1 internal failure.
 #include "commands.h"
 
 #include <libcore/status.h>
@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   add("check",
       "Metrics of a parametrization (triangle OBJ with vt) or of a quad mesh, made by any tool",
       cli::register_check);
+  add("param", "Seamless parametrization (Levi 2021) written as a UV OBJ", cli::register_param);
 
   try {
     app.parse(argc, argv);
