@@ -80,10 +80,17 @@ struct Problem {
 
   Problem(const LayoutDomain& d, const Reduction& r, const OptimizeSettings& st)
       : domain(d), red(r), s(st) {
-    faces.reserve(d.n_faces());
-    for (const auto& fc : d.face_copies)
-      faces.push_back(make_element(r, {2 * fc[0], 2 * fc[0] + 1, 2 * fc[1], 2 * fc[1] + 1,
-                                       2 * fc[2], 2 * fc[2] + 1}));
+    faces.resize(d.n_faces());
+    auto build = [&](int f) {
+      const auto& fc = d.face_copies[f];
+      faces[f] = make_element(r, {2 * fc[0], 2 * fc[0] + 1, 2 * fc[1], 2 * fc[1] + 1, 2 * fc[2],
+                                  2 * fc[2] + 1});
+    };
+#ifdef QUADIFY_WITH_TBB
+    tbb::parallel_for(0, d.n_faces(), build);
+#else
+    for (int f = 0; f < d.n_faces(); ++f) build(f);
+#endif
     if (s.penalty_rows) {
       for (const auto& row : *s.penalty_rows) {
         std::vector<int> xv;

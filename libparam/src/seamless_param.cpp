@@ -177,6 +177,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     out.stats.seconds_optimize += seconds_since(to);
   }
 
+  out.stats.n_free_variables = red.n_free();
+  out.stats.max_constraint_fill = elim.max_expression_length();
   // Output: corner UVs, seams, cones, metrics.
   const int nf = mesh.n_faces();
   out.corner_uv.resize(3 * nf, 2);
@@ -332,6 +334,8 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_batches = std::max(st.n_batches, o.stats.n_batches);
     st.total_iterations += o.stats.total_iterations;
     st.n_flipped += o.stats.n_flipped;
+    st.n_free_variables += o.stats.n_free_variables;
+    st.max_constraint_fill = std::max(st.max_constraint_fill, o.stats.max_constraint_fill);
     st.tau = std::max(st.tau, o.stats.tau);
     st.sd_max = std::max(st.sd_max, o.stats.sd_max);
     st.seam_residual = std::max(st.seam_residual, o.stats.seam_residual);

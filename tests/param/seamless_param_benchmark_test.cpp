@@ -25,9 +25,9 @@ void run_benchmark(const std::string& file, Energy energy = Energy::kTau) {
   int cone_sum = 0;
   for (const auto& c : r.cones) cone_sum += c.index;
   std::printf("[param] %s F=%d tau=%.4f sdmax=%.3f cones=%d flips=%d resid=%.2e patches=%d improved=%d "
-              "iters=%d cut=%.2fs opt=%.2fs le=%.2fs total=%.2fs status=%s\n",
+              "iters=%d fill=%d cut=%.2fs opt=%.2fs le=%.2fs total=%.2fs status=%s\n",
               file.c_str(), mesh.n_faces(), s.tau, s.sd_max, s.n_cones, s.n_flipped, s.seam_residual,
-              s.n_patches, s.n_improved, s.total_iterations, s.seconds_cut, s.seconds_optimize,
+              s.n_patches, s.n_improved, s.total_iterations, s.max_constraint_fill, s.seconds_cut, s.seconds_optimize,
               s.seconds_local_estimation, s.seconds_total, r.status.to_string().c_str());
   EXPECT_TRUE(r.status.is_ok()) << file << ": " << r.status.to_string();
   EXPECT_EQ(s.n_flipped, 0) << file;

@@ -62,6 +62,8 @@ struct ParamStats {
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int total_iterations = 0;    // Newton iterations over all optimizations (global layout)
   int n_flipped = 0;           // faces with non-positive UV orientation (exact predicate)
+  int n_free_variables = 0;    // reduced variables after all constraints (summed over components)
+  int max_constraint_fill = 0; // longest dependent-variable expression of the elimination
   double tau = 0;              // sqrt(σ1max/σ2min) of the final map; +inf if flipped
   double sd_max = 0;           // max per-face symmetric Dirichlet energy (4 = isometry)
   double seam_residual = 0;    // max |e' − R^r e| over seam edges, in UV units
