@@ -35,6 +35,9 @@ constexpr double kBatchTolerance = 1e-5;
 constexpr double kFinalTolerance = 1e-8;
 // Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau.
 constexpr double kTauPowers[] = {2, 4, 8, 16};
+// Newton iterations per continuation stage: each stage only needs to move the maximum, and
+// the stages follow each other closely.
+constexpr int kTauStageIterations = 15;
 // Exponent of the L^p ARAP energy for Energy::kLinfArap.
 constexpr double kLinfArapPower = 8;
 
@@ -168,7 +171,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       OptimizeSettings st;
       st.density = Density::kPowerSD;
       st.power = p;
-      st.max_iterations = options.max_newton_iters;
+      st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
       st.relative_tolerance = kFinalTolerance;
       const OptimizeReport rep = optimize_layout(domain, red, st, &y);
       out.stats.total_iterations += rep.iterations;
