@@ -1,5 +1,6 @@
 #include "constraint_elimination.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace quadify::param {
@@ -36,9 +37,8 @@ bool ConstraintEliminator::add_row(const SparseRow& row) {
   // Substitute the dependent variables: the row over free variables only.
   std::vector<int> touched;
   auto add = [&](int v, double a) {
-    if (scratch_[v] == 0.0) touched.push_back(v);
+    if (std::find(touched.begin(), touched.end(), v) == touched.end()) touched.push_back(v);
     scratch_[v] += a;
-    if (scratch_[v] == 0.0) scratch_[v] = 1e-300;  // keep "touched" bookkeeping simple
   };
   for (const auto& [v, a] : row.entries) {
     if (dependent_[v]) {

@@ -139,6 +139,14 @@ SeamEnds seam_ends(const CutMesh& cut, const CutSeam& s) {
 }
 }  // namespace
 
+double seam_length(const CutMesh& cut, int seam) {
+  const int f = cut.seams[seam].he_a / 3, k = cut.seams[seam].he_a % 3;
+  const Eigen::Matrix2d& dm = cut.rest[f];
+  const std::array<Eigen::Vector2d, 3> q = {Eigen::Vector2d::Zero(), Eigen::Vector2d(dm.col(0)),
+                                            Eigen::Vector2d(dm.col(1))};
+  return (q[(k + 1) % 3] - q[k]).norm();
+}
+
 std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d& x) {
   std::vector<double> m(cut.seams.size());
   for (size_t i = 0; i < cut.seams.size(); ++i) {

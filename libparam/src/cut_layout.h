@@ -55,6 +55,9 @@ struct SparseRow {
 };
 std::array<SparseRow, 2> seam_constraint_rows(const CutMesh& cut, int seam, int matching);
 
+// 3D length of the edge of seam s.
+double seam_length(const CutMesh& cut, int seam);
+
 // Applies R_90^r to a 2-vector.
 inline Eigen::Vector2d rotate_quarter(const Eigen::Vector2d& e, int r) {
   switch (((r % 4) + 4) % 4) {

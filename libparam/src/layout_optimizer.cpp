@@ -375,6 +375,9 @@ namespace {
 constexpr double kFirstPenalty = 1e3, kPenaltyGrowth = 10, kLastPenalty = 1e10;
 // Newton iterations per penalty stage.
 constexpr int kPenaltyIterations = 10;
+// Newton-decrement stop of a penalty stage, relative to the energy (tight: the penalty stage
+// must bring the new rows close before the projection).
+constexpr double kPenaltyTolerance = 1e-10;
 // Projection is attempted once every new row's residual is below this fraction of the mean
 // seam edge length (the projection then moves vertices by about as much).
 constexpr double kProjectResidual = 1e-3;
@@ -439,7 +442,7 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
     if (max_residual(x_cur) > residual_tol) {
       OptimizeSettings st;
       st.max_iterations = kPenaltyIterations;
-      st.relative_tolerance = 1e-10;
+      st.relative_tolerance = kPenaltyTolerance;
       st.penalty_rows = &new_rows;
       st.penalty_weight = w * weight_unit;
       const OptimizeReport r = optimize_layout(domain, old_red, st, &y_old);

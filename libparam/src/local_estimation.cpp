@@ -106,7 +106,7 @@ PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<i
       rows.push_back(row);
     }
     Eigen::VectorXd xs = x0;
-    const double edge_sq = cut_.rest[cut_.seams[seam].he_a / 3].col(0).squaredNorm();
+    const double edge_sq = seam_length(cut_, seam) * seam_length(cut_, seam);
     TransitionReport tr = move_into_constraints(dom, base_red, elim, rows, area / edge_sq, &xs);
     double value = std::numeric_limits<double>::infinity();
     if (tr.status.is_ok()) {

@@ -142,11 +142,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         elim.add_row(row);
         new_rows.push_back(row);
       }
-      edge_sq += cut.rest[cut.seams[s].he_a / 3].col(0).squaredNorm();
+      edge_sq += seam_length(cut, s) * seam_length(cut, s);
     }
     ++out.stats.n_batches;
     TransitionReport tr = move_into_constraints(domain, red, elim, new_rows,
-                                                total_area / std::max(edge_sq, 1e-300), &x);
+                                                total_area / edge_sq, &x);
     out.stats.total_iterations += tr.iterations;
     red = std::move(tr.reduction);
     if (!tr.status.is_ok()) {

@@ -163,7 +163,7 @@ TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
       elim.add_row(r);
       rows.push_back(r);
     }
-    edge_sq += cut.rest[cut.seams[s].he_a / 3].col(0).squaredNorm();
+    edge_sq += seam_length(cut, static_cast<int>(s)) * seam_length(cut, static_cast<int>(s));
   }
   for (double a : cut.area) area += a;
   TransitionReport tr = move_into_constraints(dom, red0, elim, rows, area / edge_sq, &x);
