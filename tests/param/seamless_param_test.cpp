@@ -183,3 +183,30 @@ TEST(SeamlessParam, TopDownOrderIsSeamless) {
 
 }  // namespace
 }  // namespace quadify::param
+
+namespace quadify::param {
+namespace {
+
+TEST(SeamlessParam, ProgressAndLocalEstimationCounters) {
+  const core::TriMesh mesh = test::make_icosphere(2);
+  ParamOptions o = fast_options();
+  std::vector<int> rounds;
+  o.progress = [&](const std::string& stage, int step, int n_steps) {
+    if (stage == "round") rounds.push_back(step);
+    EXPECT_GT(n_steps, 0);
+  };
+  const ParamResult r = compute_seamless_param(mesh, o);
+  check_result("icosphere2/progress", mesh, r);
+  EXPECT_EQ(rounds, (std::vector<int>{0, 1, 2, 3, 4})) << "one call per batch (ε = 0.1 … 0.5)";
+  EXPECT_GT(r.stats.n_patches, 0) << "a sphere needs cones, so some matchings are uncertain";
+  EXPECT_LE(r.stats.n_improved, r.stats.n_patches);
+  EXPECT_LE(r.stats.n_batches, 5);
+  ParamOptions no_le = fast_options();
+  no_le.local_estimation = false;
+  const ParamResult r2 = compute_seamless_param(mesh, no_le);
+  check_result("icosphere2/no-le", mesh, r2);
+  EXPECT_EQ(r2.stats.n_patches, 0);
+}
+
+}  // namespace
+}  // namespace quadify::param
