@@ -157,7 +157,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     st.density = density;
     st.power = power;
     st.max_iterations = options.max_newton_iters;
-    st.relative_tolerance = last ? kFinalTolerance : kBatchTolerance;
+    // With kTau the L^p continuation follows and converges the final layout.
+    st.relative_tolerance =
+        last && options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
     const OptimizeReport rep = optimize_layout(domain, red, st, &y);
     out.stats.total_iterations += rep.iterations;
     if (rep.status.is_ok()) x = red.expand(y);
