@@ -44,8 +44,9 @@ struct ParamOptions {
   int max_newton_iters = 60;
   // Allowed seam residual |e' − R^r e| of the result, relative to the bounding-box diagonal.
   double seam_tol = 1e-9;
-  // Worker threads for components and local-estimation patches; 0 = all hardware threads.
-  // The result does not depend on this number.
+  // TBB worker threads for components, local-estimation patches and per-face energy evaluation;
+  // 0 = all hardware threads. The result does not depend on this number. (CHOLMOD's own
+  // OpenMP/BLAS threads are not governed by it.)
   int threads = 0;
   // Optional progress callback (stage "round": batch step of n_steps; stage "tau": exponent of
   // the L^p continuation, out of 16). Calls are serialized, but with several components they may
