@@ -3,9 +3,11 @@
 // the integer quantization of libquantize (paper Def. 3.2), in plain data.
 //
 // Variables: the UVs of the vertex copies of the map, scalar variable 2·copy + d (d = 0: u,
-// d = 1: v). Copies are the corners merged across interior edges whose two faces agree on the
-// UVs of both endpoints; every other interior edge is a seam with a matching r, where the
-// homogeneous constraint e_b = R_90^r e_a (paper eq. 2b) always holds.
+// d = 1: v), followed by the seam translations t_s = x_b0 − R^r x_a0, variable
+// 2·#copies + 2·s + d for seam s of CopyLayout::seams. Copies are the corners merged across
+// interior edges whose two faces agree on the UVs of both endpoints; every other interior edge is a
+// seam with a matching r, where the homogeneous constraint e_b = R_90^r e_a (paper eq. 2b) always
+// holds.
 #pragma once
 
 #include <libcore/mesh.h>
@@ -14,7 +16,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
-
 #include <utility>
 #include <vector>
 
@@ -34,7 +35,7 @@ struct CopyLayout {
   std::vector<int> copy_component;  // #copies, face component (core::face_components) of each copy
   int n_components = 0;
   std::vector<CopySeam> seams;
-  Eigen::VectorXd x;                // 2·#copies, the copies' UVs
+  Eigen::VectorXd x;  // 2·#copies, the copies' UVs
   int n_copies() const { return static_cast<int>(copy_vertex.size()); }
 };
 
@@ -50,9 +51,9 @@ struct CopyLayout {
                                              const std::vector<SeamMatching>& seams,
                                              double seam_tol, CopyLayout* out);
 
-// An affine constraint Σ coef·x_var = rhs over the scalar copy variables.
+// An affine constraint Σ coef·x_var = rhs over the scalar variables (copies and translations).
 struct AffineRow {
-  std::vector<std::pair<int, double>> entries;  // (2·copy + d, coefficient)
+  std::vector<std::pair<int, double>> entries;  // (variable, coefficient)
   double rhs = 0;
 };
 
@@ -69,26 +70,28 @@ struct ConstrainedLayoutOptions {
   std::vector<int> gauge_copies;
 };
 
-// The reduced parametrization of the final constraint space: x = P·y + c. With 0/±1 input
-// coefficients (seam rows, integer-translation rows, cone rows) the elimination pivots on unit
-// coefficients, so P holds integers and c = (integer combination of the rhs and gauge values).
+// The reduced parametrization of the final constraint space: x = P·y + c over all variables
+// (copies, then translations). Copies are eliminated before translations (x_b0 = R^r x_a0 + t),
+// so with 0/±1 rows on translations and cone copies the pivots are units (P, c integer) except
+// where a cone position is fixed by translations through (I − R^r), which may leave halves.
 struct ConstrainedReduction {
-  Eigen::SparseMatrix<double, Eigen::RowMajor> P;  // 2·#copies × n_free
-  Eigen::VectorXd c;                               // 2·#copies
+  Eigen::SparseMatrix<double, Eigen::RowMajor> P;  // (2·#copies + 2·#seams) × n_free
+  Eigen::VectorXd c;                               // 2·#copies + 2·#seams
   std::vector<int> free_vars;                      // column j ↔ scalar variable free_vars[j]
 };
 
 struct ConstrainedLayoutResult {
   core::Status status;
-  Eigen::VectorXd x;             // 2·#copies, the new layout
-  std::vector<char> independent; // per new row: 1 if it was independent of all previous rows
-                                 // (dependent rows are dropped and not checked for consistency)
-  int n_flipped = 0;             // faces with non-positive orientation (exact predicate)
-  int iterations = 0;            // Newton iterations
+  Eigen::VectorXd x;              // 2·#copies + 2·#seams, the new layout and its translations
+  std::vector<char> independent;  // per new row: 1 if it was independent of all previous rows
+                                  // (dependent rows are dropped and not checked for consistency)
+  int n_flipped = 0;              // faces with non-positive orientation (exact predicate)
+  int iterations = 0;             // Newton iterations
   ConstrainedReduction reduction;
 };
 
-// Moves the layout x0 (which satisfies the seam constraints of `copies` and `old_rows`) into the
+// Moves the layout x0 (2·#copies, optionally followed by the translations, which are recomputed;
+// it satisfies the seam constraints of `copies` and `old_rows`) into the
 // space of those constraints plus `new_rows` without flips (penalty homotopy followed by a
 // projection, libparam's move_into_constraints), then minimises the energy there flip-free.
 // old_rows must be independent of each other and of the seam rows (e.g. the rows a previous call

@@ -1,0 +1,77 @@
+// Quantization of a seamless parametrization into an integer-seamless one (Levi 2021, Def. 3.2):
+// across every seam (u', v') = R_90^r (u, v) + (s, t) with (s, t) ∈ Z², and every cone at an
+// integer point, flip-free, at a chosen density. The result feeds quadex::extract_quads.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/status.h>
+#include <libparam/seamless_param.h>
+
+#include <functional>
+#include <string>
+
+namespace quadify::quantize {
+
+struct QuantizeOptions {
+  // Number of quads wanted: each unit square of the scaled map is one quad, so the map is scaled
+  // to a UV area of target_faces. 0: use edge_length; if both are 0 the default target is
+  // max(100, #F / 6) quads (about one quad per three triangle pairs).
+  int target_faces = 0;
+  // Quad edge length in model units (used when target_faces = 0): the map, near-isometric up to
+  // a global factor, is scaled so that one UV unit ≈ edge_length on the surface.
+  double edge_length = 0;
+  // Distortion minimised while moving into the integer constraints (kTau is optimized as
+  // kSymmetricDirichlet). Barrier energies keep every step flip-free.
+  param::Energy energy = param::Energy::kSymmetricDirichlet;
+  // Increment of the rounding-error threshold between batches: batch i rounds the unknowns whose
+  // distance to the nearest integer is below (i+1)·threshold_step; the last batch takes the rest.
+  double threshold_step = 0.125;
+  // Newton iterations of the flip-free re-optimization after each batch.
+  int max_newton_iters = 30;
+  // Scale refinements (×scale_growth) tried when a scale cannot be made flip-free.
+  int max_scale_retries = 3;
+  double scale_growth = 1.25;
+  // Allowed seam residual of the input |e_b − R^r e_a|, × its UV bounding-box diagonal.
+  double input_seam_tol = 1e-6;
+  // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
+  int threads = 0;
+  // Optional progress callback: stage "quantize", batch step of n_steps.
+  std::function<void(const std::string& stage, int step, int n_steps)> progress;
+};
+
+struct QuantizeStats {
+  double scale = 0;         // final factor from the input UVs to the integer map's UVs
+  int n_scale_retries = 0;  // scale refinements needed
+  int n_candidates = 0;     // integer quantities: cone-copy coordinates and seam translations
+  int n_integer_dofs = 0;   // of those, independent ones (after exact elimination)
+  int n_rounded = 0;        // candidates made integer (all of them on success)
+  int n_reverted = 0;       // batch splits and roundings to the other neighbouring integer
+  int n_batches = 0;        // constrained re-optimizations that succeeded
+  int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
+  int n_cones = 0;
+  int n_cone_collisions = 0;  // failed re-optimizations where two cones of a face coincided
+  int n_iterations = 0;       // Newton iterations in total
+  double uv_area = 0;         // UV area of the result (≈ number of quads)
+  double seconds = 0;
+};
+
+struct QuantizeResult {
+  core::Status status;
+  core::UVMesh uv;  // the input mesh with integer-seamless corner UVs, (#F·3)×2
+  QuantizeStats stats;
+};
+
+// Quantizes `seamless` (a result of param::compute_seamless_param for `mesh`, or any map with
+// seams listed with their matchings and every cone in seamless.cones) into an integer-seamless
+// map: greedy batch rounding of the independent integer unknowns, each batch followed by a
+// flip-free re-optimization, then exact snapping (see quantize.cpp for the method).
+// The result is integer-seamless bit-exactly: transitions and cone UVs are exact integers.
+// Returns kInvalidInput for a mismatching or non-seamless input (naming the edge), flipped input
+// faces, or bad options; kNotConverged when no tried scale could be made flip-free (uv holds
+// the best integer-seamless attempt, stats.n_flipped > 0, or the input when none was found);
+// kNumericalFailure when a factorization fails; kInternal if the exact verification fails.
+[[nodiscard]] QuantizeResult quantize_seamless(const core::TriMesh& mesh,
+                                               const param::ParamResult& seamless,
+                                               const QuantizeOptions& options = {});
+
+}  // namespace quadify::quantize
