@@ -9,14 +9,17 @@
 //    turned into affine rows "candidate = integer" and fed to libparam's exact incremental
 //    eliminator together with the homogeneous seam rows: a row dependent on earlier ones is an
 //    integer combination of integer rows (unit pivots, 0/±1 coefficients) and is dropped.
-// 3. Rounding. Cone coordinates first (see Rounder::run), then translations, each in batches
-//    by rounding error (below 1/8, 2/8, …; the last batch takes the rest,
-//    smallest error first within a batch). After each batch the layout is moved flip-free into
-//    the new constraint space and re-optimized (param::solve_constrained_layout: penalty homotopy
-//    + projection + barrier Newton). A batch that leaves flips (a triangle degenerated, e.g. two
-//    cones on one grid point) is reverted and split in halves; a single failing unknown is rounded
-//    to the other neighbouring integer. If that fails too, the scale grows by ×1.25 and the whole
-//    rounding restarts (up to max_scale_retries times).
+// 3. Rounding. Cone copies first (a cone fixed only through the translations around it may sit
+//    on a half-integer, see Rounder::run), then translations, each in batches by rounding error
+//    (below 1/8, 2/8, …; the last batch takes the rest; smallest error first). A cone goes to the
+//    nearest corner of its grid cell not yet taken by another cone vertex of its chart. After
+//    each batch the layout is moved flip-free into the new constraint space and re-optimized
+//    (param::solve_constrained_layout: penalty homotopy + projection + barrier Newton). A batch
+//    that leaves flips (a triangle degenerated, e.g. two cones on one grid point) or makes a
+//    fully determined unknown fractional (wrong parity) is reverted and split in halves; a single
+//    failing unknown is rounded to the other neighbouring integer. If that fails too, or after
+//    16 failed re-optimizations, the scale grows by ×1.25 and the rounding restarts (up to
+//    max_scale_retries times).
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
@@ -35,8 +38,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <optional>
+#include <tuple>
 
 namespace quadify::quantize {
 namespace {
@@ -57,6 +62,9 @@ constexpr int kMaxDenominatorBits = 8;
 // implied values are multiples of 1/4 (the determinant of I − R^r is 2 or 4), so 1/8 separates
 // them from round-off.
 constexpr double kParityTolerance = 0.125;
+// Failed re-optimizations (each a full penalty homotopy) tolerated at one scale before the scale
+// is refined: bounds the time spent on cones too close to be separated at this density.
+constexpr int kMaxFailedSolvesPerScale = 16;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
 constexpr double kFinalTolerance = 1e-7;
@@ -69,6 +77,8 @@ double seconds_since(Clock::time_point t0) {
 struct Candidate {
   std::vector<std::pair<int, double>> form;
   bool is_cone = false;  // a cone-copy coordinate (else a seam translation)
+  int copy = -1;         // the cone copy
+  int coord = 0;         // its coordinate (0: u, 1: v)
   double value(const Eigen::VectorXd& x) const {
     double v = 0;
     for (const auto& [var, a] : form) v += a * x[var];
@@ -108,6 +118,13 @@ int count_flipped(const param::CopyLayout& cl, const Eigen::VectorXd& x, int nf)
 // The state of one rounding run at a fixed scale.
 class Rounder {
  public:
+  // One integer candidate set to rhs.
+  struct Item {
+    int candidate;
+    double rhs;
+    double value;  // before rounding
+  };
+
   Rounder(const core::TriMesh& mesh, const param::CopyLayout& cl,
           const std::vector<Candidate>& candidates, const std::vector<char>& is_cone_copy,
           const param::ConstrainedLayoutOptions& layout_options, QuantizeStats* stats)
@@ -133,20 +150,8 @@ class Rounder {
         if (progress) progress("quantize", step + (cone_phase ? 0 : n_steps), 2 * n_steps);
         const bool last = step + 1 == n_steps;
         const double eps = threshold_step * (step + 1);
-        std::vector<std::pair<double, int>> batch;  // (error, candidate)
-        for (size_t i = 0; i < cand_.size(); ++i) {
-          if (decided_[i] || cand_[i].is_cone != cone_phase) continue;
-          const double v = cand_[i].value(x_);
-          const double err = std::abs(v - std::round(v));
-          if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
-        }
-        if (batch.empty()) continue;
-        std::sort(batch.begin(), batch.end());
-        std::vector<Item> items;
-        for (const auto& [err, i] : batch) {
-          const double v = cand_[i].value(x_);
-          items.push_back({i, std::round(v), v});
-        }
+        std::vector<Item> items = cone_phase ? cone_batch(eps, last) : translation_batch(eps, last);
+        if (items.empty()) continue;
         if (!process(items, last && !cone_phase)) return false;
       }
     // A final solve without new rows converges the layout further.
@@ -161,16 +166,71 @@ class Rounder {
   }
 
   const Eigen::VectorXd& x() const { return x_; }
+
+  // Translations with rounding error below eps (all when last), smallest error first.
+  std::vector<Item> translation_batch(double eps, bool last) const {
+    std::vector<std::pair<double, int>> batch;  // (error, candidate)
+    for (size_t i = 0; i < cand_.size(); ++i) {
+      if (decided_[i] || cand_[i].is_cone) continue;
+      const double v = cand_[i].value(x_);
+      const double err = std::abs(v - std::round(v));
+      if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
+    }
+    std::sort(batch.begin(), batch.end());
+    std::vector<Item> items;
+    for (const auto& [err, i] : batch) {
+      const double v = cand_[i].value(x_);
+      items.push_back({i, std::round(v), v});
+    }
+    return items;
+  }
+
+  // Cone copies whose distance (max norm) to the nearest integer point is below eps (all when
+  // last), nearest first. Each goes to the nearest corner of its grid cell that no other cone
+  // vertex of its component occupies yet (in the cut layout), so that nearby cones do not
+  // collapse onto one grid point.
+  std::vector<Item> cone_batch(double eps, bool last) const {
+    std::map<std::tuple<int, long long, long long>, int> occupied;  // (component, u, v) → vertex
+    std::vector<std::pair<double, int>> batch;  // (error, u candidate of the copy)
+    for (size_t i = 0; i < cand_.size(); ++i) {
+      if (!cand_[i].is_cone || cand_[i].coord != 0) continue;
+      const int k = cand_[i].copy;
+      const double pu = x_[2 * k], pv = x_[2 * k + 1];
+      if (decided_[i] && decided_[i + 1]) {
+        occupied[{cl_.copy_component[k], std::llround(pu), std::llround(pv)}] = cl_.copy_vertex[k];
+        continue;
+      }
+      const double err = std::max(std::abs(pu - std::round(pu)), std::abs(pv - std::round(pv)));
+      if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
+    }
+    std::sort(batch.begin(), batch.end());
+    std::vector<Item> items;
+    for (const auto& [err, i] : batch) {
+      const int k = cand_[i].copy, comp = cl_.copy_component[k], vertex = cl_.copy_vertex[k];
+      const double pu = x_[2 * k], pv = x_[2 * k + 1];
+      std::vector<std::pair<double, std::pair<double, double>>> corners;
+      for (const double gu : {std::floor(pu), std::ceil(pu)})
+        for (const double gv : {std::floor(pv), std::ceil(pv)})
+          corners.push_back({std::hypot(gu - pu, gv - pv), {gu, gv}});
+      std::sort(corners.begin(), corners.end());
+      std::pair<double, double> pick = corners[0].second;
+      for (const auto& [dist, g] : corners) {
+        const auto it = occupied.find({comp, std::llround(g.first), std::llround(g.second)});
+        if (it == occupied.end() || it->second == vertex) {
+          pick = g;
+          break;
+        }
+      }
+      occupied[{comp, std::llround(pick.first), std::llround(pick.second)}] = vertex;
+      if (!decided_[i]) items.push_back({i, pick.first, pu});
+      if (!decided_[i + 1]) items.push_back({i + 1, pick.second, pv});
+    }
+    return items;
+  }
   const param::ConstrainedReduction& reduction() const { return reduction_; }
   int n_rows() const { return static_cast<int>(rows_.size()); }
 
  private:
-  struct Item {
-    int candidate;
-    double rhs;
-    double value;  // before rounding
-  };
-
   param::AffineRow row_of(const Item& it) const {
     param::AffineRow row;
     row.entries = cand_[it.candidate].form;
@@ -193,6 +253,7 @@ class Rounder {
       ++stats_->n_batches;
       return true;
     }
+    ++n_failed_;
     if (res.status.code() == core::StatusCode::kNumericalFailure ||
         res.status.code() == core::StatusCode::kInvalidInput)
       hard_failure_ = res.status;
@@ -228,7 +289,7 @@ class Rounder {
   bool process(const std::vector<Item>& items, bool final_batch) {
     lopt_.relative_tolerance = final_batch ? kFinalTolerance : kBatchTolerance;
     if (items.empty() || try_items(items)) return true;
-    if (!hard_failure_.is_ok()) return false;
+    if (!hard_failure_.is_ok() || n_failed_ >= kMaxFailedSolvesPerScale) return false;
     ++stats_->n_reverted;
     if (items.size() > 1) {
       const size_t half = items.size() / 2;
@@ -262,6 +323,7 @@ class Rounder {
   QuantizeStats* stats_;
   Eigen::VectorXd x_;
   std::vector<char> decided_;
+  int n_failed_ = 0;  // failed re-optimizations at this scale
   std::vector<param::AffineRow> rows_;
   param::ConstrainedReduction reduction_;
 };
@@ -354,7 +416,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   std::vector<Candidate> candidates;
   for (int k = 0; k < cl.n_copies(); ++k)
     if (is_cone_copy[k])
-      for (int d = 0; d < 2; ++d) candidates.push_back({{{2 * k + d, 1.0}}, true});
+      for (int d = 0; d < 2; ++d) candidates.push_back({{{2 * k + d, 1.0}}, true, k, d});
   const int n_copy_vars = 2 * cl.n_copies();
   for (size_t si = 0; si < cl.seams.size(); ++si)
     for (int d = 0; d < 2; ++d)
