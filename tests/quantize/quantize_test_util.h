@@ -79,6 +79,7 @@ inline PipelineRun run_pipeline(const core::TriMesh& mesh, int target_faces) {
   PipelineRun run;
   auto t = Clock::now();
   param::ParamOptions po;
+  po.energy = param::Energy::kSymmetricDirichlet;
   run.param = param::compute_seamless_param(mesh, po);
   run.seconds_param = since(t);
   if (!run.param.status.is_ok()) return run;
