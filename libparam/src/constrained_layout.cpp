@@ -17,6 +17,10 @@
 namespace quadify::param {
 namespace {
 
+// Dimensionless penalty weights (× area / Σ edge²) of the optional long homotopy.
+constexpr double kHomotopyWeights[] = {1e0, 1e2, 1e4, 1e6};
+// Newton stop of the homotopy stages (fraction of the energy): run the iterations out.
+constexpr double kHomotopyTolerance = 1e-12;
 // Exponent of the L^p ARAP density for Energy::kLinfArap (as in compute_seamless_param).
 constexpr double kLinfArapPower = 8;
 
@@ -277,6 +281,22 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
     const double weight_unit =
         total_area /
         std::max(1e-300, 0.5 * static_cast<double>(added.size()) * edge_len * edge_len);
+        // Optional long homotopy inside the old space before the transition: large moves (cones
+    // pulled apart onto distinct grid points) need more Newton steps than its stages take.
+    if (options.homotopy_iterations > 0) {
+      Eigen::VectorXd y = old_red.restrict(x);
+      for (const double w : kHomotopyWeights) {
+        OptimizeSettings st;
+        st.max_iterations = options.homotopy_iterations;
+        st.relative_tolerance = kHomotopyTolerance;
+        st.penalty_rows = &added;
+        st.penalty_weight = w * weight_unit;
+        const OptimizeReport r = optimize_layout(domain, old_red, st, &y);
+        res.iterations += r.iterations;
+        if (!r.status.is_ok()) break;
+        x = old_red.expand(y);
+      }
+    }
     TransitionReport tr = move_into_constraints(domain, old_red, elim, added, weight_unit, &x);
     res.iterations += tr.iterations;
     red = std::move(tr.reduction);

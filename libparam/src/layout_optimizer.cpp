@@ -13,6 +13,7 @@
 #endif
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -32,6 +33,15 @@ constexpr double kRegularization = 1e-9;
 // Below this many faces the per-face evaluation runs serially (patches; thread overhead).
 constexpr int kParallelMinFaces = 2048;
 
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// P holds sums of products of small integers; a difference of two rows below this is
+// cancellation round-off, i.e. zero.
+constexpr double kCancelledCoefficient = 1e-12;
+
 // One element of the energy: local scalar variables, mapped to reduced variables by M (dense
 // n_local × n_reduced, rows = P rows), the reduced ids, and the offsets of its Hessian entries.
 struct Element {
@@ -40,29 +50,55 @@ struct Element {
   std::vector<int> offsets;  // ys.size()² positions in the Hessian value array (sparse) or -1
 };
 
-Element make_element(const Reduction& red, const std::vector<int>& xvars) {
+// Element of the local linear forms rows[i] (over reduced variables).
+Element make_element(const std::vector<SparseRow>& rows) {
   Element el;
-  for (int v : xvars)
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
-      el.ys.push_back(static_cast<int>(it.col()));
+  for (const auto& row : rows)
+    for (const auto& [v, a] : row.entries) el.ys.push_back(v);
   std::sort(el.ys.begin(), el.ys.end());
   el.ys.erase(std::unique(el.ys.begin(), el.ys.end()), el.ys.end());
-  el.M = Eigen::MatrixXd::Zero(xvars.size(), el.ys.size());
-  for (size_t i = 0; i < xvars.size(); ++i)
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, xvars[i]); it; ++it) {
-      const auto pos = std::lower_bound(el.ys.begin(), el.ys.end(), static_cast<int>(it.col()));
-      el.M(i, pos - el.ys.begin()) += it.value();
+  el.M = Eigen::MatrixXd::Zero(rows.size(), el.ys.size());
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (const auto& [v, a] : rows[i].entries) {
+      const auto pos = std::lower_bound(el.ys.begin(), el.ys.end(), v);
+      el.M(i, pos - el.ys.begin()) += a;
     }
   return el;
 }
 
-// Gradient matrix G (3×2) of the barycentric basis: J = Σ_k x_k ⊗ G_k.
-Eigen::Matrix<double, 3, 2> basis_gradients(const Eigen::Matrix2d& dm_inv) {
-  Eigen::Matrix<double, 3, 2> g;
-  g.row(0) = -dm_inv.row(0) - dm_inv.row(1);
-  g.row(1) = dm_inv.row(0);
-  g.row(2) = dm_inv.row(1);
-  return g;
+Element make_element(const Reduction& red, const std::vector<int>& xvars) {
+  std::vector<SparseRow> rows(xvars.size());
+  for (size_t i = 0; i < xvars.size(); ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, xvars[i]); it; ++it)
+      rows[i].entries.push_back({static_cast<int>(it.col()), it.value()});
+  return make_element(rows);
+}
+
+// The element of a face over the four edge-vector coordinates (x1−x0, x2−x0 per axis, local
+// variable 2j+d): the energy depends on them only, and the translation parts that the three
+// corner expressions share (a copy across a seam is R·x + t with a long t) cancel here.
+Element make_face_element(const Reduction& red, const std::array<int, 3>& fc) {
+  std::vector<SparseRow> rows(4);
+  std::vector<std::pair<int, double>> merged;
+  for (int j = 0; j < 2; ++j)
+    for (int d = 0; d < 2; ++d) {
+      auto& e = rows[2 * j + d].entries;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, 2 * fc[j + 1] + d); it; ++it)
+        e.push_back({static_cast<int>(it.col()), it.value()});
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, 2 * fc[0] + d); it; ++it)
+        e.push_back({static_cast<int>(it.col()), -it.value()});
+      std::sort(e.begin(), e.end());
+      merged.clear();
+      for (const auto& [v, a] : e) {
+        if (!merged.empty() && merged.back().first == v)
+          merged.back().second += a;
+        else
+          merged.push_back({v, a});
+      }
+      std::erase_if(merged, [](const auto& p) { return std::abs(p.second) <= kCancelledCoefficient; });
+      e = merged;
+    }
+  return make_element(rows);
 }
 
 struct Problem {
@@ -83,8 +119,7 @@ struct Problem {
     faces.resize(d.n_faces());
     auto build = [&](int f) {
       const auto& fc = d.face_copies[f];
-      faces[f] = make_element(r, {2 * fc[0], 2 * fc[0] + 1, 2 * fc[1], 2 * fc[1] + 1, 2 * fc[2],
-                                  2 * fc[2] + 1});
+      faces[f] = make_face_element(r, fc);
     };
 #ifdef QUADIFY_WITH_TBB
     tbb::parallel_for(0, d.n_faces(), build);
@@ -178,16 +213,18 @@ struct Problem {
       face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
       if (!derivatives || !ev.finite) return;
       // B (4×6): vec(J) index 2d+r, local variable 2k+d, entry G(k, r).
-      const Eigen::Matrix<double, 3, 2> G = basis_gradients(domain.rest_inverse[f]);
-      Eigen::Matrix<double, 4, 6> B = Eigen::Matrix<double, 4, 6>::Zero();
-      for (int k = 0; k < 3; ++k)
+      // B (4×4): vec(J) index 2d+r, local variable 2j+d (coordinate d of x_{j+1} − x_0),
+      // entry Dm⁻¹(j, r).
+      const Eigen::Matrix2d& dmi = domain.rest_inverse[f];
+      Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
+      for (int j = 0; j < 2; ++j)
         for (int d = 0; d < 2; ++d)
-          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * k + d) = G(k, r);
-      const Eigen::Matrix<double, 6, 1> g6 = a * B.transpose() * ev.gradient;
-      const Eigen::Matrix<double, 6, 6> h6 = a * B.transpose() * ev.hessian * B;
+          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * j + d) = dmi(j, r);
+      const Eigen::Vector4d g4 = a * B.transpose() * ev.gradient;
+      const Eigen::Matrix4d h4 = a * B.transpose() * ev.hessian * B;
       const Element& el = faces[f];
-      face_gy[f].noalias() = el.M.transpose() * g6;
-      face_hy[f].noalias() = el.M.transpose() * h6 * el.M;
+      face_gy[f].noalias() = el.M.transpose() * g4;
+      face_hy[f].noalias() = el.M.transpose() * h4 * el.M;
     };
 #ifdef QUADIFY_WITH_TBB
     if (nf >= kParallelMinFaces)
@@ -293,11 +330,18 @@ Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd
 OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
                                const OptimizeSettings& settings, Eigen::VectorXd* y) {
   OptimizeReport rep;
+  auto tc = Clock::now();
   Problem prob(domain, red, settings);
+  rep.timers.setup += seconds_since(tc);
+  rep.hessian_nonzeros = prob.dense ? 0 : prob.H.nonZeros();
+  for (const Element& el : prob.faces)
+    rep.max_element_variables = std::max(rep.max_element_variables, static_cast<int>(el.ys.size()));
   const int n = red.n_free();
   Eigen::VectorXd x = red.expand(*y);
   Eigen::VectorXd g;
+  tc = Clock::now();
   double energy = prob.evaluate(x, true, &g);
+  rep.timers.assembly += seconds_since(tc);
   rep.initial_energy = energy;
   if (!std::isfinite(energy)) {
     rep.status = core::Status::numerical_failure("layout optimization: start is flipped");
@@ -313,6 +357,7 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
   for (int it = 0; it < settings.max_iterations; ++it) {
     // Newton direction with the PSD-projected Hessian (+ a tiny shift for the rotation mode).
     Eigen::VectorXd dy;
+    tc = Clock::now();
     double mean_diag = prob.dense ? prob.Hd.diagonal().mean()
                                   : Eigen::VectorXd(prob.H.diagonal()).mean();
     if (!(mean_diag > 0)) mean_diag = 1;
@@ -330,20 +375,25 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
         Eigen::SparseMatrix<double> A = prob.H;
         for (int i = 0; i < n; ++i) A.coeffRef(i, i) += shift;
         if (!analyzed) {
+          const auto ta = Clock::now();
           if (!solver.analyze(A).is_ok()) break;
           analyzed = true;
+          rep.timers.analyze += seconds_since(ta);
+          tc = Clock::now();
         }
         if (!solver.factorize(A).is_ok()) continue;
         dy = -solver.solve(g);
         solved = true;
       }
     }
+    rep.timers.factorize += seconds_since(tc);
     if (!solved || !dy.allFinite()) {
       rep.status = core::Status::numerical_failure("layout optimization: Newton system failed");
       break;
     }
     const double decrement = -g.dot(dy);
     if (decrement <= settings.relative_tolerance * std::abs(energy)) break;
+    tc = Clock::now();
     const Eigen::VectorXd dx = red.P * dy;
     double alpha = std::min(1.0, kFlipFreeStepFraction * max_flip_free_step(domain, x, dx));
     double trial = std::numeric_limits<double>::infinity();
@@ -354,12 +404,15 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
       trial = prob.evaluate(x_trial, false, nullptr);
       if (trial <= energy - kArmijo * alpha * decrement) break;
     }
+    rep.timers.line_search += seconds_since(tc);
     if (bt == kMaxBacktracks) break;  // no decrease possible: converged to round-off
     *y += alpha * dy;
     x = red.expand(*y);
     ++rep.iterations;
     const double previous = energy;
+    tc = Clock::now();
     energy = prob.evaluate(x, true, &g);
+    rep.timers.assembly += seconds_since(tc);
     if (previous - energy <= 1e-3 * settings.relative_tolerance * std::abs(previous)) break;
   }
   rep.energy = energy;
@@ -383,7 +436,14 @@ constexpr double kPenaltyTolerance = 1e-10;
 constexpr double kProjectResidual = 1e-3;
 
 // Least-squares y with P·y + c ≈ x.
-Eigen::VectorXd project(const Reduction& red, const Eigen::VectorXd& x, core::Status* status) {
+Eigen::VectorXd project(const Reduction& red, const Eigen::VectorXd& x, core::Status* status,
+                        double* seconds) {
+  const auto t0 = Clock::now();
+  struct AddTime {
+    Clock::time_point t0;
+    double* s;
+    ~AddTime() { *s += seconds_since(t0); }
+  } add_time{t0, seconds};
   const Eigen::SparseMatrix<double> P = red.P;
   Eigen::SparseMatrix<double> PtP = P.transpose() * P;
   core::SparseSolver solver;
@@ -407,7 +467,9 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
                                        const std::vector<SparseRow>& new_rows, double weight_unit,
                                        Eigen::VectorXd* x) {
   TransitionReport rep;
+  const auto t_red = Clock::now();
   rep.reduction = elim.reduction(*x);
+  rep.timers.setup += seconds_since(t_red);
   // weight_unit = area / Σ edge²: recover the mean squared length of the new seam edges.
   double area = 0;
   for (double a : domain.area) area += a;
@@ -430,7 +492,7 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   // the new matchings are close to the measured rotations).
   {
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps);
+    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       return rep;
@@ -447,6 +509,7 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
       st.penalty_weight = w * weight_unit;
       const OptimizeReport r = optimize_layout(domain, old_red, st, &y_old);
       rep.iterations += r.iterations;
+      rep.timers += r.timers;
       if (!r.status.is_ok()) {
         rep.status = r.status;
         break;
@@ -455,7 +518,7 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
       if (max_residual(x_cur) > residual_tol) continue;
     }
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps);
+    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       break;
@@ -471,7 +534,7 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   }
   if (best_flips == INT32_MAX) {
     core::Status ps;
-    x_best = rep.reduction.expand(project(rep.reduction, x_cur, &ps));
+    x_best = rep.reduction.expand(project(rep.reduction, x_cur, &ps, &rep.timers.projection));
     best_flips = count_flipped(domain, x_best);
   }
   rep.n_flipped = best_flips;

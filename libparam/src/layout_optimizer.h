@@ -37,8 +37,30 @@ struct OptimizeSettings {
   double penalty_weight = 0;
 };
 
+// Wall-clock seconds spent in the parts of the optimizer (profiling; summed over calls).
+struct OptimizeTimers {
+  double setup = 0;        // element maps (PᵀHP structure) and Hessian pattern
+  double assembly = 0;     // energy, gradient and Hessian evaluations at accepted points
+  double analyze = 0;      // symbolic analysis of the sparse solver
+  double factorize = 0;    // numeric factorization and solve
+  double line_search = 0;  // flip-free step bound and backtracking evaluations
+  double projection = 0;   // least-squares projections onto a new constraint space
+  OptimizeTimers& operator+=(const OptimizeTimers& o) {
+    setup += o.setup;
+    assembly += o.assembly;
+    analyze += o.analyze;
+    factorize += o.factorize;
+    line_search += o.line_search;
+    projection += o.projection;
+    return *this;
+  }
+};
+
 struct OptimizeReport {
   core::Status status;
+  OptimizeTimers timers;
+  long long hessian_nonzeros = 0;   // of the reduced Hessian PᵀHP (sparse mode), both triangles
+  int max_element_variables = 0;    // reduced variables of the widest face element
   int iterations = 0;
   double energy = 0;            // area-weighted density sum (+ penalty)
   double initial_energy = 0;
@@ -63,6 +85,7 @@ namespace quadify::param {
 
 struct TransitionReport {
   core::Status status;
+  OptimizeTimers timers;
   Reduction reduction;   // of the new constraint set
   int iterations = 0;
   int n_flipped = 0;     // flipped faces after the move (exact predicate); 0 on success

@@ -1,5 +1,6 @@
 #include <libparam/seamless_param.h>
 
+#include "cone_pairs.h"
 #include "constraint_elimination.h"
 #include "cut_layout.h"
 #include "layout_optimizer.h"
@@ -16,6 +17,7 @@
 
 #include <chrono>
 #include <climits>
+#include <functional>
 #include <cmath>
 #include <mutex>
 #include <numbers>
@@ -48,6 +50,18 @@ struct ComponentOutput {
   std::vector<ConeInfo> cones;
   ParamStats stats;
 };
+
+void add_timers(const OptimizeTimers& t, ParamStats* s) {
+  s->seconds_setup += t.setup;
+  s->seconds_assembly += t.assembly;
+  s->seconds_analyze += t.analyze;
+  s->seconds_factorize += t.factorize;
+  s->seconds_line_search += t.line_search;
+  s->seconds_projection += t.projection;
+}
+
+// Failed re-optimizations tolerated by the cone-pair cancellation before it keeps what it has.
+constexpr int kMaxCancellationFailures = 6;
 
 double batch_threshold(const ParamOptions& o, int i) {
   return o.order == RoundingOrder::kBottomUp ? o.threshold_step * (i + 1)
@@ -134,6 +148,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
+    auto te = Clock::now();
     double edge_sq = 0;
     for (size_t i = 0; i < batch.size(); ++i) {
       const int s = batch[i];
@@ -144,10 +159,13 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       }
       edge_sq += seam_length(cut, s) * seam_length(cut, s);
     }
+    out.stats.seconds_elimination += seconds_since(te);
     ++out.stats.n_batches;
     TransitionReport tr = move_into_constraints(domain, red, elim, new_rows,
                                                 total_area / edge_sq, &x);
     out.stats.total_iterations += tr.iterations;
+    out.stats.n_transition_iterations += tr.iterations;
+    add_timers(tr.timers, &out.stats);
     red = std::move(tr.reduction);
     if (!tr.status.is_ok()) {
       out.status = tr.status;
@@ -162,7 +180,84 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         last && options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
     const OptimizeReport rep = optimize_layout(domain, red, st, &y);
     out.stats.total_iterations += rep.iterations;
+    out.stats.n_batch_iterations += rep.iterations;
+    add_timers(rep.timers, &out.stats);
+    out.stats.max_hessian_nonzeros = std::max(out.stats.max_hessian_nonzeros, rep.hessian_nonzeros);
+    out.stats.max_element_variables =
+        std::max(out.stats.max_element_variables, rep.max_element_variables);
     if (rep.status.is_ok()) x = red.expand(y);
+    out.stats.seconds_optimize += seconds_since(to);
+  }
+  // Cone-pair cancellation: change the matchings of a set of pairs' seam paths, rebuild the
+  // constraint space without those seams' old rows, and move the layout into the new rows like a
+  // batch. A set that cannot be made flip-free is split in halves.
+  if (options.cone_pair_distance > 0 && out.status.is_ok()) {
+    const auto to = Clock::now();
+    const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
+        mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
+        options.cone_pair_max_hops);
+    int failures = 0;
+    std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
+      if (begin >= end || failures >= kMaxCancellationFailures) return;
+      std::vector<int> new_matching = matching;
+      std::vector<char> changed(n_seams, 0);
+      for (size_t i = begin; i < end; ++i)
+        for (const SeamChange& ch : pairs[i].changes) {
+          new_matching[ch.seam] += ch.delta;
+          changed[ch.seam] = 1;
+        }
+      ConstraintEliminator kept(n_vars, gauge);
+      for (int s = 0; s < n_seams; ++s)
+        if (!changed[s])
+          for (const SparseRow& row : seam_constraint_rows(cut, s, matching[s])) kept.add_row(row);
+      const Reduction kept_red = kept.reduction(x);
+      ConstraintEliminator full = kept;
+      std::vector<SparseRow> new_rows;
+      double edge_sq = 0;
+      for (int s = 0; s < n_seams; ++s)
+        if (changed[s]) {
+          for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s])) {
+            full.add_row(row);
+            new_rows.push_back(row);
+          }
+          edge_sq += seam_length(cut, s) * seam_length(cut, s);
+        }
+      Eigen::VectorXd x_try = x;
+      TransitionReport tr =
+          move_into_constraints(domain, kept_red, full, new_rows, total_area / edge_sq, &x_try);
+      out.stats.total_iterations += tr.iterations;
+      out.stats.n_transition_iterations += tr.iterations;
+      add_timers(tr.timers, &out.stats);
+      bool ok = tr.status.is_ok() && tr.n_flipped == 0;
+      if (ok) {
+        Eigen::VectorXd y = tr.reduction.restrict(x_try);
+        OptimizeSettings st;
+        st.density = density;
+        st.power = power;
+        st.max_iterations = options.max_newton_iters;
+        st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
+        const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
+        out.stats.total_iterations += rep.iterations;
+        out.stats.n_batch_iterations += rep.iterations;
+        add_timers(rep.timers, &out.stats);
+        if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
+        ok = count_flipped(domain, x_try) == 0;
+      }
+      if (ok) {
+        matching = std::move(new_matching);
+        elim = std::move(full);
+        red = std::move(tr.reduction);
+        x = std::move(x_try);
+        out.stats.n_cancelled_pairs += static_cast<int>(end - begin);
+        return;
+      }
+      ++failures;
+      if (end - begin < 2) return;
+      const size_t mid = begin + (end - begin) / 2;
+      apply(begin, mid);
+      apply(mid, end);
+    };
+    apply(0, pairs.size());
     out.stats.seconds_optimize += seconds_since(to);
   }
   if (options.energy == Energy::kTau) {
@@ -177,8 +272,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.relative_tolerance = kFinalTolerance;
       const OptimizeReport rep = optimize_layout(domain, red, st, &y);
       out.stats.total_iterations += rep.iterations;
+      out.stats.n_tau_iterations += rep.iterations;
+      add_timers(rep.timers, &out.stats);
       if (rep.status.is_ok() && std::isfinite(rep.energy)) x = red.expand(y);
     }
+    out.stats.seconds_tau += seconds_since(to);
     out.stats.seconds_optimize += seconds_since(to);
   }
 
@@ -246,6 +344,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
     return core::Status::invalid_input("threshold_step must be in (0, 0.5]");
   if (o.patch_bfs_levels < 1) return core::Status::invalid_input("patch_bfs_levels must be >= 1");
   if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
+  if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
+    return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
   if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
   if (mesh.n_faces() == 0) return core::Status::invalid_input("mesh has no faces");
   if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
@@ -337,6 +437,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_patches += o.stats.n_patches;
     st.n_improved += o.stats.n_improved;
     st.n_batches = std::max(st.n_batches, o.stats.n_batches);
+    st.n_cancelled_pairs += o.stats.n_cancelled_pairs;
     st.total_iterations += o.stats.total_iterations;
     st.n_flipped += o.stats.n_flipped;
     st.n_free_variables += o.stats.n_free_variables;
@@ -347,6 +448,19 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.seconds_cut += o.stats.seconds_cut;
     st.seconds_optimize += o.stats.seconds_optimize;
     st.seconds_local_estimation += o.stats.seconds_local_estimation;
+    st.seconds_elimination += o.stats.seconds_elimination;
+    st.seconds_setup += o.stats.seconds_setup;
+    st.seconds_assembly += o.stats.seconds_assembly;
+    st.seconds_analyze += o.stats.seconds_analyze;
+    st.seconds_factorize += o.stats.seconds_factorize;
+    st.seconds_line_search += o.stats.seconds_line_search;
+    st.seconds_projection += o.stats.seconds_projection;
+    st.seconds_tau += o.stats.seconds_tau;
+    st.n_transition_iterations += o.stats.n_transition_iterations;
+    st.n_batch_iterations += o.stats.n_batch_iterations;
+    st.n_tau_iterations += o.stats.n_tau_iterations;
+    st.max_hessian_nonzeros = std::max(st.max_hessian_nonzeros, o.stats.max_hessian_nonzeros);
+    st.max_element_variables = std::max(st.max_element_variables, o.stats.max_element_variables);
   }
   const double diag = core::bbox_diagonal(mesh.V);
   if (result.status.is_ok() && st.seam_residual > options.seam_tol * diag)

@@ -65,6 +65,8 @@ constexpr double kParityTolerance = 0.125;
 // Failed re-optimizations (each a full penalty homotopy) tolerated at one scale before the scale
 // is refined: bounds the time spent on cones too close to be separated at this density.
 constexpr int kMaxFailedSolvesPerScale = 16;
+// Newton iterations per stage of the long penalty homotopy used for a single failing unknown.
+constexpr int kSingleHomotopyIterations = 40;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
 constexpr double kFinalTolerance = 1e-7;
@@ -296,10 +298,13 @@ class Rounder {
       return process({items.begin(), items.begin() + half}, final_batch) &&
              process(refresh({items.begin() + half, items.end()}), final_batch);
     }
-    // A single unknown: the other neighbouring integer.
+    // A single unknown: the same integer with a longer homotopy, then the other neighbour.
+    lopt_.homotopy_iterations = kSingleHomotopyIterations;
     Item other = items[0];
     other.rhs = other.value < other.rhs ? other.rhs - 1 : other.rhs + 1;
-    return try_items({other});
+    const bool ok = try_items(items) || try_items({other});
+    lopt_.homotopy_iterations = 0;
+    return ok;
   }
 
   // Re-rounds items from the current layout (after part of their batch was committed).
@@ -538,6 +543,21 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
 }
 
 }  // namespace
+
+double target_edge_length(const core::TriMesh& mesh, const QuantizeOptions& options) {
+  if (options.target_faces <= 0 && options.edge_length > 0) return options.edge_length;
+  double area3d = 0;
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
+    area3d += 0.5 * (Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0)
+                        .cross(Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0)
+                        .norm();
+  }
+  const int target = options.target_faces > 0
+                         ? options.target_faces
+                         : std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
+  return std::sqrt(area3d / target);
+}
 
 QuantizeResult quantize_seamless(const core::TriMesh& mesh, const param::ParamResult& seamless,
                                  const QuantizeOptions& options) {

@@ -87,6 +87,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"cones", s.n_cones},
                      {"patches", s.n_patches},
                      {"improved", s.n_improved},
+                     {"cancelled_pairs", s.n_cancelled_pairs},
                      {"batches", s.n_batches},
                      {"iterations", s.total_iterations},
                      {"flipped", s.n_flipped},
@@ -146,6 +147,14 @@ CommandRunner register_param(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-newton-iters", o.max_newton_iters, "Newton iterations per layout optimization")
       ->check(CLI::Range(1, 10000))
+      ->capture_default_str();
+  app.add_option("--cone-pair-distance", o.cone_pair_distance,
+                 "Remove pairs of opposite cones joined by a path of at most --cone-pair-hops seam edges "
+                 "shorter than this (model units) by changing the matchings along it (0 = off, the paper)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--cone-pair-hops", o.cone_pair_max_hops, "Seam edges of a cone-pair cancellation path")
+      ->check(CLI::Range(1, 10))
       ->capture_default_str();
   return [args](const CommonOptions& common) { return run_param(*args, common); };
 }

@@ -15,5 +15,6 @@ using CommandRunner = std::function<int(const CommonOptions&)>;
 CommandRunner register_info(CLI::App& app);
 CommandRunner register_check(CLI::App& app);
 CommandRunner register_param(CLI::App& app);
+CommandRunner register_remesh(CLI::App& app);
 
 }  // namespace quadify::cli

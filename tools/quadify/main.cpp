@@ -1,10 +1,12 @@
-// quadify: triangle mesh → quad mesh. Subcommands: info, check, param (the end-to-end run
-// arrives with quantization). Exit codes: 0 ok, 2 bad input, 1 internal failure.
+// quadify: triangle mesh → quad mesh. Subcommands: remesh (the default), info, check, param. Exit codes: 0 ok, 2 bad input, 1 internal failure.
 #include "commands.h"
 
 #include <libcore/status.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <string>
+#include <vector>
 #include <map>
 #include <new>
 
@@ -14,7 +16,12 @@
 
 namespace {
 
-constexpr const char* kFooter = R"(Exit codes:
+constexpr const char* kFooter = R"(Typical use:
+  quadify bunny.stl -o bunny_quads.obj --target-faces 5000   remesh (OBJ, glTF or GLB out)
+  quadify info scan.ply                                      what the file holds, what repair does
+  quadify check result.obj --reference bunny.stl             quality of any quad mesh or UV map
+
+Exit codes:
   0  success
   2  bad input: the file cannot be read or used, or the options are invalid (one line on stderr
      names the file and the problem; no output file is written)
@@ -51,9 +58,22 @@ int main(int argc, char** argv) {
       "Metrics of a parametrization (triangle OBJ with vt) or of a quad mesh, made by any tool",
       cli::register_check);
   add("param", "Seamless parametrization (Levi 2021) written as a UV OBJ", cli::register_param);
+  add("remesh", "Triangle mesh to quad mesh (the default: `quadify IN -o OUT` means `quadify remesh IN -o OUT`)",
+      cli::register_remesh);
+
+  // `quadify IN -o OUT` is `quadify remesh IN -o OUT`: insert the subcommand when none is named.
+  std::vector<std::string> args(argv + 1, argv + argc);
+  const bool names_subcommand = std::any_of(args.begin(), args.end(), [&](const std::string& a) {
+    return a == "info" || a == "check" || a == "param" || a == "remesh";
+  });
+  const bool only_global = std::all_of(args.begin(), args.end(), [](const std::string& a) {
+    return a == "-h" || a == "--help" || a == "--version";
+  });
+  if (!names_subcommand && !only_global) args.insert(args.begin(), "remesh");
+  std::reverse(args.begin(), args.end());  // CLI11 takes the arguments reversed
 
   try {
-    app.parse(argc, argv);
+    app.parse(args);
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);  // prints help/version or the error
     return code == 0 ? cli::kExitOk : cli::kExitBadInput;

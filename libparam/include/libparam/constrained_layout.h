@@ -65,6 +65,10 @@ struct ConstrainedLayoutOptions {
   int max_newton_iters = 60;
   // Newton stop: decrement below this fraction of the energy.
   double relative_tolerance = 1e-6;
+  // Newton iterations per stage of an extra penalty homotopy (weights 1, 1e2, 1e4, 1e6 × area /
+  // Σ edge²) inside the old space before the transition; 0 = none. For new rows far from the
+  // current layout.
+  int homotopy_iterations = 0;
   // One copy per component keeps its current position (the translation gauge); -1 = the first
   // copy of the component.
   std::vector<int> gauge_copies;

@@ -44,6 +44,14 @@ struct ParamOptions {
   int max_newton_iters = 60;
   // Allowed seam residual |e' − R^r e| of the result, relative to the bounding-box diagonal.
   double seam_tol = 1e-9;
+  // Cone-pair cancellation (not in the paper; for quad meshing): after the last batch, pairs of a
+  // +1 and a −1 cone joined by a path of at most cone_pair_max_hops seam edges whose 3D length is
+  // at most cone_pair_distance (model units) are removed by changing the matchings along the path
+  // by one quarter turn, followed by a flip-free re-optimization (a set that cannot be made
+  // flip-free is split and retried, then dropped). Such pairs cannot sit on two distinct integer
+  // points of a grid coarser than their distance. 0 = off (the paper's method).
+  double cone_pair_distance = 0;
+  int cone_pair_max_hops = 3;
   // TBB worker threads for components, local-estimation patches and per-face energy evaluation;
   // 0 = all hardware threads. The result does not depend on this number. (CHOLMOD's own
   // OpenMP/BLAS threads are not governed by it.)
@@ -61,6 +69,7 @@ struct ParamStats {
   int n_patches = 0;           // local-estimation patches laid out
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
+  int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
   int total_iterations = 0;    // Newton iterations over all optimizations (global layout)
   int n_flipped = 0;           // faces with non-positive UV orientation (exact predicate)
   int n_free_variables = 0;    // reduced variables after all constraints (summed over components)
@@ -70,6 +79,15 @@ struct ParamStats {
   double seam_residual = 0;    // max |e' − R^r e| over seam edges, in UV units
   double seconds_cut = 0, seconds_optimize = 0, seconds_local_estimation = 0,
          seconds_total = 0;
+  // Profile of seconds_optimize (summed over components): constraint elimination, element maps
+  // and Hessian pattern (setup), energy/gradient/Hessian evaluation (assembly), symbolic analysis,
+  // numeric factorization + solve, line search, least-squares projections, and the part spent in
+  // the τ continuation. Newton iterations split by phase.
+  double seconds_elimination = 0, seconds_setup = 0, seconds_assembly = 0, seconds_analyze = 0,
+         seconds_factorize = 0, seconds_line_search = 0, seconds_projection = 0, seconds_tau = 0;
+  long long max_hessian_nonzeros = 0;  // largest reduced Hessian of the global layout
+  int max_element_variables = 0;       // reduced variables of the widest face element
+  int n_transition_iterations = 0, n_batch_iterations = 0, n_tau_iterations = 0;
 };
 
 // One seam edge of the result: the edge (edge_vertex0, edge_vertex1) shared by face_a and face_b.

@@ -61,6 +61,11 @@ struct QuantizeResult {
   QuantizeStats stats;
 };
 
+// The quad edge length in model units that `options` ask for on `mesh`: options.edge_length, or
+// sqrt(3D area / target quads) with the target (or default target) face count. Used to size
+// density-dependent choices before the map exists (e.g. param::ParamOptions::cone_pair_distance).
+[[nodiscard]] double target_edge_length(const core::TriMesh& mesh, const QuantizeOptions& options);
+
 // Quantizes `seamless` (a result of param::compute_seamless_param for `mesh`, or any map with
 // seams listed with their matchings and every cone in seamless.cones) into an integer-seamless
 // map: greedy batch rounding of the independent integer unknowns, each batch followed by a

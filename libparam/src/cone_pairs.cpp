@@ -1,0 +1,113 @@
+#include "cone_pairs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+namespace quadify::param {
+
+std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
+                                const Eigen::VectorXd& x) {
+  const int nv = mesh.n_vertices(), nf = mesh.n_faces();
+  std::vector<double> angle_sum(nv, 0.0);
+  std::vector<char> on_boundary(nv, 0);
+  for (int h = 0; h < 3 * nf; ++h)
+    if (cut.topo.twin[h] < 0)
+      on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
+      const Eigen::Vector2d u = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 1) % 3])) - p;
+      const Eigen::Vector2d w = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 2) % 3])) - p;
+      angle_sum[mesh.F(f, k)] += std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w));
+    }
+  std::vector<int> index(nv, 0);
+  for (int v = 0; v < nv; ++v)
+    if (!on_boundary[v] && angle_sum[v] != 0)
+      index[v] = 4 - static_cast<int>(std::lround(angle_sum[v] / (0.5 * std::numbers::pi)));
+  return index;
+}
+
+namespace {
+
+struct SeamStep {
+  int to = -1;
+  int seam = -1;
+  int orientation = 0;  // +1 when the step runs v0 → v1 of the seam
+  double length = 0;
+};
+
+struct PathSearch {
+  const std::vector<std::vector<SeamStep>>& adjacency;
+  const std::vector<int>& index;
+  const std::vector<char>& on_boundary;
+  double max_length;
+  int max_hops;
+  int source;
+  std::vector<SeamChange> path;
+  std::vector<int> visited;
+  std::vector<ConePairCancellation>* found;
+
+  void extend(int v, double length) {
+    for (const SeamStep& st : adjacency[v]) {
+      const double l = length + st.length;
+      if (l > max_length || on_boundary[st.to]) continue;
+      if (std::find(visited.begin(), visited.end(), st.to) != visited.end()) continue;
+      path.push_back({st.seam, st.orientation});
+      if (index[st.to] == -1) {
+        found->push_back({source, st.to, l, path});
+      } else if (index[st.to] == 0 && static_cast<int>(path.size()) < max_hops) {
+        visited.push_back(st.to);
+        extend(st.to, l);
+        visited.pop_back();
+      }
+      path.pop_back();
+    }
+  }
+};
+
+}  // namespace
+
+std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
+                                                               const CutMesh& cut,
+                                                               const std::vector<int>& index,
+                                                               double max_length, int max_hops) {
+  std::vector<ConePairCancellation> result;
+  if (!(max_length > 0) || max_hops < 1) return result;
+  const int nv = mesh.n_vertices();
+  std::vector<char> on_boundary(nv, 0);
+  for (int h = 0; h < 3 * mesh.n_faces(); ++h)
+    if (cut.topo.twin[h] < 0)
+      on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  std::vector<std::vector<SeamStep>> adjacency(nv);
+  for (int s = 0; s < static_cast<int>(cut.seams.size()); ++s) {
+    const int f = cut.seams[s].he_a / 3, k = cut.seams[s].he_a % 3;
+    const int v0 = mesh.F(f, k), v1 = mesh.F(f, (k + 1) % 3);
+    const double l = seam_length(cut, s);
+    adjacency[v0].push_back({v1, s, +1, l});
+    adjacency[v1].push_back({v0, s, -1, l});
+  }
+  std::vector<ConePairCancellation> candidates;
+  for (int p = 0; p < nv; ++p) {
+    if (index[p] != 1 || on_boundary[p]) continue;
+    PathSearch search{adjacency, index, on_boundary, max_length, max_hops, p, {}, {p}, &candidates};
+    search.extend(p, 0.0);
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.path_length, a.positive_vertex, a.negative_vertex) <
+           std::tie(b.path_length, b.positive_vertex, b.negative_vertex);
+  });
+  std::vector<char> used_vertex(nv, 0), used_seam(cut.seams.size(), 0);
+  for (const ConePairCancellation& c : candidates) {
+    if (used_vertex[c.positive_vertex] || used_vertex[c.negative_vertex]) continue;
+    if (std::any_of(c.changes.begin(), c.changes.end(), [&](const SeamChange& ch) { return used_seam[ch.seam]; }))
+      continue;
+    used_vertex[c.positive_vertex] = used_vertex[c.negative_vertex] = 1;
+    for (const SeamChange& ch : c.changes) used_seam[ch.seam] = 1;
+    result.push_back(c);
+  }
+  return result;
+}
+
+}  // namespace quadify::param

@@ -1,0 +1,51 @@
+// Cancellation of close pairs of opposite cones by changing the matchings along a short seam
+// path between them. Internal to libparam.
+//
+// Why: minimising τ with local estimation rounds some matchings so that a +1 and a −1 cone sit on
+// the two ends of one or two short edges (a "dipole"). Such a pair lowers the distortion a little
+// but cannot be placed on two distinct integer points of a quad grid whose cells are larger than
+// its distance, which makes the integer quantization infeasible at a useful density, and it adds
+// two irregular vertices to the quad mesh. Raising the matching of seam edge (v0→v1 in face_a) by
+// one quarter turn lowers the index of v0 and raises the index of v1 by one (the rotation from
+// face_a to face_b is a clockwise step around v0 and a counter-clockwise one around v1), so
+// changing every seam of a path p → q by ±1 moves one unit of index from p to q and leaves the
+// inner vertices of the path unchanged: a +1/−1 pair disappears.
+#pragma once
+
+#include "cut_layout.h"
+
+#include <libcore/mesh.h>
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace quadify::param {
+
+// A matching change: seam `seam` of the cut gets `delta` quarter turns more.
+struct SeamChange {
+  int seam = -1;
+  int delta = 0;
+};
+
+// One pair of cones to cancel and the seam changes that cancel it.
+struct ConePairCancellation {
+  int positive_vertex = -1, negative_vertex = -1;
+  double path_length = 0;  // 3D length of the seam path
+  std::vector<SeamChange> changes;
+};
+
+// Index of every vertex of the seamless layout x (2·#copies): 4 − (UV angle sum)/(π/2), 0 at
+// boundary vertices.
+std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
+                                const Eigen::VectorXd& x);
+
+// Disjoint pairs (+1, −1) of interior cones joined by a path of at most max_hops seam edges and
+// 3D length at most max_length whose inner vertices are regular interior vertices; greedily by
+// path length (shortest first, ties by vertex ids: deterministic). Cones of |index| > 1 are left
+// alone.
+std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
+                                                               const CutMesh& cut,
+                                                               const std::vector<int>& index,
+                                                               double max_length, int max_hops);
+
+}  // namespace quadify::param

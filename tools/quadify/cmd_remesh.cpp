@@ -1,0 +1,184 @@
+// quadify [remesh] IN -o OUT.{obj,gltf,glb}: the whole pipeline — read and repair, seamless
+// parametrization (libparam), integer-seamless quantization (libquantize), quad extraction
+// (libquadex), export — with progress per stage and the quad metrics in the report.
+#include "commands.h"
+
+#include <libcore/write_mesh.h>
+#include <libparam/seamless_param.h>
+#include <libquadex/extract_quads.h>
+#include <libquadex/quad_metrics.h>
+#include <libquantize/quantize.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+
+namespace quadify::cli {
+namespace {
+
+struct RemeshArgs {
+  std::string input;
+  std::string output;
+  int target_faces = 0;
+  double edge_length = 0;
+  bool keep_uv = false;
+  bool measure = true;
+  param::ParamOptions param;
+  int samples = 100'000;
+  double cone_pair_distance = 1.5;  // × the target quad edge length
+};
+
+const std::map<std::string, param::Energy> kEnergies = {
+    {"tau", param::Energy::kTau},
+    {"sd", param::Energy::kSymmetricDirichlet},
+    {"arap", param::Energy::kArap},
+    {"linf-arap", param::Energy::kLinfArap},
+    {"conformal", param::Energy::kConformal},
+};
+
+nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
+  Progress progress(common.quiet);
+  const LoadedMesh loaded = load_and_repair(args.input, progress);
+  const core::TriMesh& mesh = loaded.repaired.mesh;
+  auto on_progress = [&progress](const std::string& stage, int step, int n_steps) {
+    progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
+  };
+
+  quantize::QuantizeOptions quantize_options;
+  quantize_options.target_faces = args.target_faces;
+  quantize_options.edge_length = args.edge_length;
+  quantize_options.threads = common.threads;
+  quantize_options.progress = on_progress;
+  const double quad_edge = quantize::target_edge_length(mesh, quantize_options);
+
+  param::ParamOptions param_options = args.param;
+  param_options.cone_pair_distance = args.cone_pair_distance * quad_edge;
+  param_options.threads = common.threads;
+  param_options.progress = on_progress;
+  progress.begin("param");
+  const param::ParamResult seamless = param::compute_seamless_param(mesh, param_options);
+  progress.end();
+  if (seamless.status.code() == core::StatusCode::kInvalidInput)
+    throw CliError{kExitBadInput, args.input + ": " + seamless.status.message()};
+  if (!seamless.status.is_ok())
+    throw CliError{kExitInternal, args.input + ": seamless parametrization failed: " + seamless.status.to_string()};
+
+  progress.begin("quantize");
+  const quantize::QuantizeResult integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
+  progress.end();
+  if (!integer_map.status.is_ok())
+    throw CliError{kExitInternal, args.input + ": quantization failed: " + integer_map.status.to_string() +
+                                      " (a larger --target-faces often helps)"};
+
+  quadex::ExtractOptions extract_options;
+  extract_options.output_uv = args.keep_uv;
+  progress.begin("extract");
+  quadex::ExtractResult extracted = quadex::extract_quads(integer_map.uv, extract_options);
+  progress.end();
+  if (!extracted.status.is_ok())
+    throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
+  if (!args.keep_uv) {
+    extracted.quads.uv.resize(0, 2);
+    extracted.quads.face_uv.clear();
+  }
+
+  progress.begin("write");
+  core::write_mesh(args.output, extracted.quads);
+  progress.end();
+
+  nlohmann::json report;
+  report["command"] = "remesh";
+  report["status"] = "ok";
+  report["input"] = input_json(args.input, loaded.raw);
+  report["repair"] = to_json(loaded.repaired.report);
+  report["mesh"] = to_json(core::topology_stats(mesh));
+  report["output"] = args.output;
+  const param::ParamStats& ps = seamless.stats;
+  report["param"] = {{"cones", ps.n_cones},           {"seam_edges", ps.n_seam_edges},
+                     {"patches", ps.n_patches},       {"improved", ps.n_improved},
+                     {"cancelled_pairs", ps.n_cancelled_pairs},
+                     {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
+                     {"seconds", ps.seconds_total}};
+  const quantize::QuantizeStats& qs = integer_map.stats;
+  report["quantize"] = {{"scale", qs.scale},          {"target_faces", args.target_faces},
+                        {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
+                        {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
+                        {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
+                        {"seconds", qs.seconds}};
+  const quadex::ExtractStats& es = extracted.stats;
+  report["extract"] = {{"vertices", es.n_vertices}, {"faces", es.n_faces}, {"non_quads", es.n_non_quads},
+                       {"boundary_crossings", es.n_boundary_crossings}, {"seconds", es.seconds}};
+  if (args.measure) {
+    progress.begin("measure");
+    quadex::QuadMetricsOptions metric_options;
+    metric_options.hausdorff_samples = args.samples;
+    const quadex::QuadMetrics m = quadex::compute_quad_metrics(extracted.quads, &mesh, metric_options);
+    progress.end();
+    report["quads"] = {{"faces", m.n_faces},
+                       {"non_quads", m.n_non_quads},
+                       {"irregular_vertices", m.n_irregular},
+                       {"flipped_quads", m.n_flipped},
+                       {"manifold", m.manifold},
+                       {"components", m.n_components},
+                       {"genus", m.genus},
+                       {"sj_min", number(m.sj_min)},
+                       {"sj_mean", number(m.sj_mean)},
+                       {"angle_dev_mean", number(m.angle_dev_mean)},
+                       {"hausdorff_sym", number(m.hausdorff_sym)},
+                       {"mean_dist_sym", number(m.mean_dist_sym)},
+                       {"feature_capture", m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json()}};
+    if (!common.quiet)
+      std::printf("%s -> %s: %d faces (%d not quads), %d irregular vertices, %d flipped, Hausdorff %.3g of the "
+                  "diagonal\n",
+                  args.input.c_str(), args.output.c_str(), m.n_faces, m.n_non_quads, m.n_irregular, m.n_flipped,
+                  m.hausdorff_sym);
+  } else if (!common.quiet) {
+    std::printf("%s -> %s: %d faces (%d not quads)\n", args.input.c_str(), args.output.c_str(), es.n_faces,
+                es.n_non_quads);
+  }
+  report["timings"] = progress.timings();
+  write_report(common, report);
+  return kExitOk;
+}
+
+}  // namespace
+
+CommandRunner register_remesh(CLI::App& app) {
+  auto args = std::make_shared<RemeshArgs>();
+  app.add_option("input", args->input, "Triangle mesh (OBJ, OFF, PLY, STL, glTF, GLB)")->required()->type_name("IN");
+  app.add_option("-o,--output", args->output,
+                 "Quad mesh to write: .obj (quads as 4-vertex faces), .gltf (+.bin) or .glb (triangulated "
+                 "surface + quad wireframe as lines)")
+      ->required()
+      ->type_name("OUT");
+  auto* target = app.add_option("--target-faces", args->target_faces,
+                                "Number of quads wanted (default: max(100, #triangles/6))")
+                     ->check(CLI::Range(1, 100'000'000))
+                     ->type_name("N");
+  app.add_option("--edge-length", args->edge_length, "Quad edge length in model units (instead of --target-faces)")
+      ->check(CLI::PositiveNumber)
+      ->excludes(target)
+      ->type_name("H");
+  app.add_option("--energy", args->param.energy,
+                 "Distortion minimised by the parametrization: tau (default), sd, arap, linf-arap, conformal")
+      ->transform(CLI::CheckedTransformer(kEnergies, CLI::ignore_case))
+      ->default_str("tau");
+  app.add_option("--cone-pair-distance", args->cone_pair_distance,
+                 "Remove pairs of opposite cones (valence 3 next to valence 5) joined by a seam path "
+                 "shorter than this many quad edge lengths, by changing the matchings along the path "
+                 "(they cannot sit on distinct grid points; 0 = keep every cone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
+  app.add_flag("!--no-measure", args->measure,
+               "Skip the quality measures (Hausdorff distance, scaled Jacobian) of the report");
+  app.add_option("--samples", args->samples, "Area samples per surface for the Hausdorff distance")
+      ->check(CLI::Range(1000, 10'000'000))
+      ->capture_default_str();
+  return [args](const CommonOptions& common) { return run_remesh(*args, common); };
+}
+
+}  // namespace quadify::cli
