@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The two commands of the README.
 #   scripts/quickstart.sh demo : install what is missing, build Release, remesh a bundled example
+#                                (examples/data/spot.obj → build/demo/spot_quads.{obj,glb})
 #   scripts/quickstart.sh test : install what is missing, build Release, run the whole test suite,
 #                                then the fast tests again under AddressSanitizer + UBSan
 set -euo pipefail
@@ -21,9 +22,12 @@ case "$mode" in
     configure_build build -DQUADIFY_BUILD_TESTS=OFF
     out="$here/build/demo"
     mkdir -p "$out"
-    ./build/bin/quadify info examples/data/spot.obj --json "$out/spot_info.json"
+    ./build/bin/quadify examples/data/spot.obj -o "$out/spot_quads.obj" --target-faces 3000 \
+      --json "$out/spot_report.json"
+    ./build/bin/quadify examples/data/spot.obj -o "$out/spot_quads.glb" --target-faces 3000 --quiet
     echo
-    echo "quadify: report written to $out/spot_info.json"
+    echo "quadify: quad mesh written to $out/spot_quads.obj (and $out/spot_quads.glb for a glTF viewer)"
+    echo "quadify: report (timings, cones, quad quality, Hausdorff distance) in $out/spot_report.json"
     ;;
   test)
     bash scripts/install_deps.sh --with-test-tools

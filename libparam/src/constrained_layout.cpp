@@ -271,7 +271,9 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   int n_never_pivot = 0;
   for (char c : never_pivot) n_never_pivot += c;
   Reduction red;
-  if (n_vars - n_never_pivot - elim.rank() == 0) {
+  if (options.reduce_only) {
+    red = elim.reduction(x);
+  } else if (n_vars - n_never_pivot - elim.rank() == 0) {
     // No freedom left (e.g. every vertex pinned): the layout is the constant part. Handled here
     // because the projection would factor an empty matrix.
     red = elim.reduction(x);
@@ -281,7 +283,7 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
     const double weight_unit =
         total_area /
         std::max(1e-300, 0.5 * static_cast<double>(added.size()) * edge_len * edge_len);
-        // Optional long homotopy inside the old space before the transition: large moves (cones
+    // Optional long homotopy inside the old space before the transition: large moves (cones
     // pulled apart onto distinct grid points) need more Newton steps than its stages take.
     if (options.homotopy_iterations > 0) {
       Eigen::VectorXd y = old_red.restrict(x);
@@ -304,8 +306,8 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   } else {
     red = old_red;
   }
-  res.n_flipped = count_flipped(domain, x);
-  if (res.n_flipped == 0 && res.status.is_ok()) {
+  res.n_flipped = options.reduce_only ? 0 : count_flipped(domain, x);
+  if (!options.reduce_only && res.n_flipped == 0 && res.status.is_ok()) {
     OptimizeSettings st;
     switch (options.energy) {
       case Energy::kArap:

@@ -41,6 +41,7 @@
 #include <map>
 #include <numeric>
 #include <optional>
+#include <limits>
 #include <tuple>
 
 namespace quadify::quantize {
@@ -65,6 +66,10 @@ constexpr double kParityTolerance = 0.125;
 // Failed re-optimizations (each a full penalty homotopy) tolerated at one scale before the scale
 // is refined: bounds the time spent on cones too close to be separated at this density.
 constexpr int kMaxFailedSolvesPerScale = 16;
+// Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
+constexpr double kConePairMeshEdges = 8;
+// Sweeps over a batch of the parity repair (each tries every item's other neighbour once).
+constexpr int kParityRepairPasses = 3;
 // Newton iterations per stage of the long penalty homotopy used for a single failing unknown.
 constexpr int kSingleHomotopyIterations = 40;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
@@ -240,13 +245,55 @@ class Rounder {
     return row;
   }
 
-  bool try_items(const std::vector<Item>& items) {
+  // Candidates that `items` (on top of the committed rows) would imply fractional: an
+  // elimination only, no solve.
+  std::vector<int> offenders_of(const std::vector<Item>& items) const {
+    std::vector<param::AffineRow> new_rows;
+    for (const Item& it : items) new_rows.push_back(row_of(it));
+    param::ConstrainedLayoutOptions reduce = lopt_;
+    reduce.reduce_only = true;
+    const param::ConstrainedLayoutResult res =
+        param::solve_constrained_layout(mesh_, cl_, x_, rows_, new_rows, reduce);
+    std::vector<int> offenders = implied_fractional(res.reduction, items);
+    return offenders;
+  }
+
+  // Parity repair before any solve: while the batch implies fractional candidates, move single
+  // roundings to their other neighbouring integer when that lowers the number of offenders
+  // (changing one coordinate of a ±1 cone by one flips the parity of (I − R)·x). Returns false
+  // when the offenders cannot be removed this way.
+  bool repair_parity(std::vector<Item>* items) const {
+    std::vector<int> offenders = offenders_of(*items);
+    for (int pass = 0; pass < kParityRepairPasses && !offenders.empty(); ++pass) {
+      bool improved = false;
+      for (size_t i = 0; i < items->size() && !offenders.empty(); ++i) {
+        Item& it = (*items)[i];
+        const double kept = it.rhs;
+        it.rhs = it.value < kept ? kept - 1 : kept + 1;
+        std::vector<int> trial = offenders_of(*items);
+        if (trial.size() < offenders.size()) {
+          offenders = std::move(trial);
+          improved = true;
+        } else {
+          it.rhs = kept;
+        }
+      }
+      if (!improved) break;
+    }
+    return offenders.empty();
+  }
+
+  bool try_items(std::vector<Item> items) {
+    if (!repair_parity(&items)) {
+      ++n_failed_;
+      return false;
+    }
     std::vector<param::AffineRow> new_rows;
     for (const Item& it : items) new_rows.push_back(row_of(it));
     param::ConstrainedLayoutResult res =
         param::solve_constrained_layout(mesh_, cl_, x_, rows_, new_rows, lopt_);
     stats_->n_iterations += res.iterations;
-    if (res.status.is_ok() && res.n_flipped == 0 && implied_values_integer(res.reduction)) {
+    if (res.status.is_ok() && res.n_flipped == 0) {
       for (size_t i = 0; i < items.size(); ++i) {
         decided_[items[i].candidate] = 1;
         if (res.independent[i]) rows_.push_back(new_rows[i]);
@@ -275,16 +322,24 @@ class Rounder {
 
   // Candidates that the constraints now determine completely (an empty row of P) must come out
   // as integers. A cone fixed through (I − R^r) by other integers can land on a half-integer:
-  // then one of the new roundings has the wrong parity and the batch is split until the
-  // culprit is rounded to its other neighbour.
-  bool implied_values_integer(const param::ConstrainedReduction& red) const {
+  // returns those (undecided) candidates; process() then rounds them first, from the current
+  // layout, so that the other roundings cannot force them onto the wrong parity.
+  std::vector<int> implied_fractional(const param::ConstrainedReduction& red,
+                                      const std::vector<Item>& items) const {
+    // Items are checked too: an item whose row depends on earlier rows is dropped by the
+    // elimination, and its implied value need not be its rounding.
+    std::vector<int> offenders;
+    std::vector<double> rhs(cand_.size(), std::numeric_limits<double>::quiet_NaN());
+    for (const Item& it : items) rhs[it.candidate] = it.rhs;
     for (size_t i = 0; i < cand_.size(); ++i) {
       if (decided_[i]) continue;
       const int v = cand_[i].form[0].first;
       if (red.P.row(v).nonZeros() != 0) continue;
-      if (std::abs(red.c[v] - std::round(red.c[v])) > kParityTolerance) return false;
+      if (std::abs(red.c[v] - std::round(red.c[v])) > kParityTolerance ||
+          (!std::isnan(rhs[i]) && std::abs(red.c[v] - rhs[i]) > kParityTolerance))
+        offenders.push_back(static_cast<int>(i));
     }
-    return true;
+    return offenders;
   }
 
   // Commits the items, splitting the batch on failure.
@@ -375,10 +430,11 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   const int nf = mesh.n_faces();
   if (options.target_faces < 0 || !(options.edge_length >= 0) || !(options.threshold_step > 0) ||
       options.threshold_step > 0.5 || !(options.scale_growth > 1) ||
-      options.max_scale_retries < 0) {
+      options.max_scale_retries < 0 || options.near_scale_tries < 0 ||
+      !(options.near_scale_step >= 0 && options.near_scale_step < 0.2)) {
     out.status = core::Status::invalid_input(
         "quantize options: need target_faces ≥ 0, edge_length ≥ 0, 0 < threshold_step ≤ 0.5, "
-        "scale_growth > 1, max_scale_retries ≥ 0");
+        "scale_growth > 1, max_scale_retries ≥ 0, near_scale_tries ≥ 0, 0 ≤ near_scale_step < 0.2");
     return out;
   }
   if (nf == 0 || seamless.uv.corner_uv.rows() != 3 * nf) {
@@ -457,8 +513,19 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   lopt.gauge_copies = gauge;
   std::optional<Eigen::VectorXd> best;
   core::Status failure;
-  for (int attempt = 0; attempt <= options.max_scale_retries; ++attempt) {
+  // Scales tried: the target, small jitters that keep the quad count within about ±8% (a
+  // greedy rounding that dead-ends often succeeds from a slightly different start), then
+  // refinements by scale_growth.
+  std::vector<double> scales = {scale};
+  for (int j = 1; j <= options.near_scale_tries; ++j) {
+    const double jitter = options.near_scale_step * ((j + 1) / 2);
+    scales.push_back(scale * (j % 2 == 1 ? 1 + jitter : 1 - jitter));
+  }
+  for (int r = 1; r <= options.max_scale_retries; ++r)
+    scales.push_back(scale * std::pow(options.scale_growth, r));
+  for (int attempt = 0; attempt < static_cast<int>(scales.size()); ++attempt) {
     st.n_scale_retries = attempt;
+    scale = scales[attempt];
     // Scaled copies, each component translated so that its gauge copy is at the origin, then
     // the seam translations.
     Eigen::VectorXd x(n_copy_vars + 2 * cl.seams.size());
@@ -494,13 +561,12 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       best = xe;
       break;
     }
-    scale *= options.scale_growth;
   }
   if (!best) {
     out.status =
         failure.is_ok()
             ? core::Status::not_converged("no flip-free integer-seamless map within " +
-                                          std::to_string(options.max_scale_retries + 1) + " scales")
+                                          std::to_string(scales.size()) + " scales")
             : failure;
     st.seconds = seconds_since(t0);
     return out;
@@ -557,6 +623,17 @@ double target_edge_length(const core::TriMesh& mesh, const QuantizeOptions& opti
                          ? options.target_faces
                          : std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
   return std::sqrt(area3d / target);
+}
+
+double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeOptions& options,
+                                      double quad_edges) {
+  if (!(quad_edges > 0) || mesh.n_faces() == 0) return 0;
+  double sum = 0;
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      sum += (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
+  const double mean_edge = sum / (3.0 * mesh.n_faces());
+  return std::max(quad_edges * target_edge_length(mesh, options), kConePairMeshEdges * mean_edge);
 }
 
 QuantizeResult quantize_seamless(const core::TriMesh& mesh, const param::ParamResult& seamless,

@@ -78,14 +78,16 @@ inline PipelineRun run_pipeline(const core::TriMesh& mesh, int target_faces) {
   };
   PipelineRun run;
   auto t = Clock::now();
+  quantize::QuantizeOptions qo;
+  qo.target_faces = target_faces;
   param::ParamOptions po;
   po.energy = param::Energy::kSymmetricDirichlet;
+  po.cone_pair_distance = quantize::recommended_cone_pair_distance(mesh, qo);
+  po.cone_pair_max_hops = quantize::kRecommendedConePairHops;
   run.param = param::compute_seamless_param(mesh, po);
   run.seconds_param = since(t);
   if (!run.param.status.is_ok()) return run;
   t = Clock::now();
-  quantize::QuantizeOptions qo;
-  qo.target_faces = target_faces;
   run.quantized = quantize::quantize_seamless(mesh, run.param, qo);
   run.seconds_quantize = since(t);
   if (!run.quantized.status.is_ok()) return run;

@@ -9,6 +9,7 @@
 #include <libquadex/quad_metrics.h>
 #include <libquantize/quantize.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -26,7 +27,7 @@ struct RemeshArgs {
   bool measure = true;
   param::ParamOptions param;
   int samples = 100'000;
-  double cone_pair_distance = 1.5;  // × the target quad edge length
+  double cone_pair_distance = 4;  // × the target quad edge length
 };
 
 const std::map<std::string, param::Energy> kEnergies = {
@@ -52,10 +53,11 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   quantize_options.edge_length = args.edge_length;
   quantize_options.threads = common.threads;
   quantize_options.progress = on_progress;
-  const double quad_edge = quantize::target_edge_length(mesh, quantize_options);
 
   param::ParamOptions param_options = args.param;
-  param_options.cone_pair_distance = args.cone_pair_distance * quad_edge;
+  param_options.cone_pair_distance =
+      quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
+  param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   progress.begin("param");
@@ -168,8 +170,9 @@ CommandRunner register_remesh(CLI::App& app) {
       ->default_str("tau");
   app.add_option("--cone-pair-distance", args->cone_pair_distance,
                  "Remove pairs of opposite cones (valence 3 next to valence 5) joined by a seam path "
-                 "shorter than this many quad edge lengths, by changing the matchings along the path "
-                 "(they cannot sit on distinct grid points; 0 = keep every cone)")
+                 "shorter than this many quad edge lengths (and at least 8 mean edge lengths of the input), "
+                 "by changing the matchings along the path: such pairs cannot sit on distinct grid points "
+                 "and add two irregular vertices (0 = keep every cone)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");

@@ -69,6 +69,10 @@ struct ConstrainedLayoutOptions {
   // Σ edge²) inside the old space before the transition; 0 = none. For new rows far from the
   // current layout.
   int homotopy_iterations = 0;
+  // Only eliminate: fill result.reduction and result.independent and return x0 projected onto
+  // the old space, without moving into the new rows (no optimization, n_flipped not counted).
+  // Cheap; used to check which values new rows imply before paying for a solve.
+  bool reduce_only = false;
   // One copy per component keeps its current position (the translation gauge); -1 = the first
   // copy of the component.
   std::vector<int> gauge_copies;

@@ -28,7 +28,11 @@ struct QuantizeOptions {
   double threshold_step = 0.125;
   // Newton iterations of the flip-free re-optimization after each batch.
   int max_newton_iters = 30;
-  // Scale refinements (×scale_growth) tried when a scale cannot be made flip-free.
+  // When the rounding dead-ends at the target scale, it restarts at the scales ×(1 ± k·
+  // near_scale_step), k = 1, 1, 2, 2, … (near_scale_tries of them: the quad count stays within
+  // about ±8% of the target), then at the refinements ×scale_growth^k, k = 1..max_scale_retries.
+  int near_scale_tries = 4;
+  double near_scale_step = 0.02;
   int max_scale_retries = 3;
   double scale_growth = 1.25;
   // Allowed seam residual of the input |e_b − R^r e_a|, × its UV bounding-box diagonal.
@@ -41,7 +45,7 @@ struct QuantizeOptions {
 
 struct QuantizeStats {
   double scale = 0;         // final factor from the input UVs to the integer map's UVs
-  int n_scale_retries = 0;  // scale refinements needed
+  int n_scale_retries = 0;  // restarts at another scale (near ones first, then refinements)
   int n_candidates = 0;     // integer quantities: cone-copy coordinates and seam translations
   int n_integer_dofs = 0;   // of those, independent ones (after exact elimination)
   int n_rounded = 0;        // candidates made integer (all of them on success)
@@ -65,6 +69,15 @@ struct QuantizeResult {
 // sqrt(3D area / target quads) with the target (or default target) face count. Used to size
 // density-dependent choices before the map exists (e.g. param::ParamOptions::cone_pair_distance).
 [[nodiscard]] double target_edge_length(const core::TriMesh& mesh, const QuantizeOptions& options);
+
+// The param::ParamOptions::cone_pair_distance that suits quantization at `options`' density:
+// quad_edges target quad edge lengths, and at least 8 mean edge lengths of the input (the pairs
+// made by the rounding of matchings sit a few mesh edges apart whatever the density); 0 when
+// quad_edges ≤ 0. Use with cone_pair_max_hops = kRecommendedConePairHops.
+[[nodiscard]] double recommended_cone_pair_distance(const core::TriMesh& mesh,
+                                                    const QuantizeOptions& options,
+                                                    double quad_edges = 4);
+inline constexpr int kRecommendedConePairHops = 6;
 
 // Quantizes `seamless` (a result of param::compute_seamless_param for `mesh`, or any map with
 // seams listed with their matchings and every cone in seamless.cones) into an integer-seamless
