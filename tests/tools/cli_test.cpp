@@ -242,6 +242,45 @@ TEST_F(CliTest, ParamWritesSeamlessFlipFreeUvObj) {
   EXPECT_LT(j["tau"].get<double>(), 3.0);
 }
 
+// The default command end to end, measured by `check --reference` on the written file.
+TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
+  const fs::path out = dir_ / "spot_quads.obj";
+  const std::string spot = data_path("spot.obj").string();
+  std::string args;  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
+  args.append("'").append(spot).append("' -o '").append(out.string());
+  args.append("' --target-faces 1500 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(fs::exists(out));
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["command"], "remesh");
+  EXPECT_EQ(report["quantize"]["flipped"], 0);
+  const CliRun c = quadify("check '" + out.string() + "' --reference '" + spot + "' --json '" +
+                               (dir_ / "c.json").string() + "'",
+                           dir_);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["kind"], "quad");
+  EXPECT_EQ(j["non_quads"], 0);
+  EXPECT_EQ(j["manifold"], true);
+  EXPECT_EQ(j["components"], 1);
+  EXPECT_EQ(j["euler_characteristic"], 2) << "spot is a sphere";
+  EXPECT_NEAR(j["faces"].get<int>(), 1500, 150) << "face count within 10% of the target";
+  // About 1% of the diagonal at this coarse density (0.66% at 5,000 quads).
+  EXPECT_LT(j["hausdorff_sym"].get<double>(), 0.02);
+}
+
+TEST_F(CliTest, RemeshOnBrokenInputWritesNothing) {
+  write_text(dir_ / "bad.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n");  // truncated
+  const fs::path out = dir_ / "out.glb";
+  std::string args;
+  args.append("'").append((dir_ / "bad.stl").string()).append("' -o '").append(out.string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("bad.stl"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(CliTest, ParamOnBrokenInputWritesNothing) {
   write_text(dir_ / "bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");  // truncated
   const fs::path out = dir_ / "out.obj";
