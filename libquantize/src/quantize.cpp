@@ -17,9 +17,11 @@
 //    (param::solve_constrained_layout: penalty homotopy + projection + barrier Newton). A batch
 //    that leaves flips (a triangle degenerated, e.g. two cones on one grid point) or makes a
 //    fully determined unknown fractional (wrong parity) is reverted and split in halves; a single
-//    failing unknown is rounded to the other neighbouring integer. If that fails too, or after
-//    16 failed re-optimizations, the scale grows by ×1.25 and the rounding restarts (up to
-//    max_scale_retries times).
+//    failing unknown is rounded to the other neighbouring integer. Parity is checked before any
+//    solve by the elimination alone (see Rounder::repair_parity); a run that dead-ends because
+//    both neighbours of an unknown imply a fractional cone restarts with those cones first.
+//    If that fails too, or after 16 failed re-optimizations, the rounding restarts at nearby
+//    scales (×1 ± 2%, ±4%), then at scales grown by ×1.25 (max_scale_retries times).
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
@@ -68,6 +70,8 @@ constexpr double kParityTolerance = 0.125;
 constexpr int kMaxFailedSolvesPerScale = 16;
 // Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
 constexpr double kConePairMeshEdges = 8;
+// Restarts at one scale with the cones that a run found doomed by parity rounded first.
+constexpr int kMaxPriorityRestarts = 4;
 // Sweeps over a batch of the parity repair (each tries every item's other neighbour once).
 constexpr int kParityRepairPasses = 3;
 // Newton iterations per stage of the long penalty homotopy used for a single failing unknown.
@@ -140,7 +144,8 @@ class Rounder {
         cand_(candidates),
         is_cone_copy_(is_cone_copy),
         lopt_(layout_options),
-        stats_(stats) {}
+        stats_(stats),
+        priority_(candidates.size(), 0) {}
 
   // Rounds every candidate starting from x (satisfying the seam rows); false when stuck.
   bool run(Eigen::VectorXd x, double threshold_step,
@@ -173,6 +178,8 @@ class Rounder {
   }
 
   const Eigen::VectorXd& x() const { return x_; }
+  const std::vector<int>& doomed() const { return doomed_; }
+  void set_priority(const std::vector<char>& priority) { priority_ = priority; }
 
   // Translations with rounding error below eps (all when last), smallest error first.
   std::vector<Item> translation_batch(double eps, bool last) const {
@@ -207,7 +214,11 @@ class Rounder {
         occupied[{cl_.copy_component[k], std::llround(pu), std::llround(pv)}] = cl_.copy_vertex[k];
         continue;
       }
-      const double err = std::max(std::abs(pu - std::round(pu)), std::abs(pv - std::round(pv)));
+      // Priority cones (those a previous run at this scale found doomed) go first, in the first
+      // batch, so that the later roundings can still be moved to fix their parity.
+      const double err = priority_[i]
+                             ? -1.0
+                             : std::max(std::abs(pu - std::round(pu)), std::abs(pv - std::round(pv)));
       if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
     }
     std::sort(batch.begin(), batch.end());
@@ -285,9 +296,11 @@ class Rounder {
 
   bool try_items(std::vector<Item> items) {
     if (!repair_parity(&items)) {
+      last_offenders_ = offenders_of(items);
       ++n_failed_;
       return false;
     }
+    last_offenders_.clear();
     std::vector<param::AffineRow> new_rows;
     for (const Item& it : items) new_rows.push_back(row_of(it));
     param::ConstrainedLayoutResult res =
@@ -328,13 +341,30 @@ class Rounder {
                                       const std::vector<Item>& items) const {
     // Items are checked too: an item whose row depends on earlier rows is dropped by the
     // elimination, and its implied value need not be its rounding.
+    // Pairs are checked as well: two undecided candidates with the same free part (P rows equal
+    // up to sign) and offsets that differ by a non-integer (a ± b = ½, typical of a ±1 cone and a
+    // translation through I − R) can never both be integers, which a greedy order would only see
+    // once one of them is fixed, too late to repair.
     std::vector<int> offenders;
     std::vector<double> rhs(cand_.size(), std::numeric_limits<double>::quiet_NaN());
     for (const Item& it : items) rhs[it.candidate] = it.rhs;
+    std::map<std::vector<std::pair<int, double>>, std::pair<int, double>> free_part;
     for (size_t i = 0; i < cand_.size(); ++i) {
       if (decided_[i]) continue;
       const int v = cand_[i].form[0].first;
-      if (red.P.row(v).nonZeros() != 0) continue;
+      if (red.P.row(v).nonZeros() != 0) {
+        std::vector<std::pair<int, double>> key;
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
+          key.push_back({static_cast<int>(it.col()), it.value()});
+        const double sign = key.front().second < 0 ? -1 : 1;
+        for (auto& [col, a] : key) a *= sign;
+        const double offset = sign * red.c[v];
+        const auto [pos, inserted] = free_part.try_emplace(key, static_cast<int>(i), offset);
+        const double diff = offset - pos->second.second;
+        if (!inserted && std::abs(diff - std::round(diff)) > kParityTolerance)
+          offenders.push_back(static_cast<int>(i));
+        continue;
+      }
       if (std::abs(red.c[v] - std::round(red.c[v])) > kParityTolerance ||
           (!std::isnan(rhs[i]) && std::abs(red.c[v] - rhs[i]) > kParityTolerance))
         offenders.push_back(static_cast<int>(i));
@@ -357,7 +387,17 @@ class Rounder {
     lopt_.homotopy_iterations = kSingleHomotopyIterations;
     Item other = items[0];
     other.rhs = other.value < other.rhs ? other.rhs - 1 : other.rhs + 1;
-    const bool ok = try_items(items) || try_items({other});
+    bool ok = try_items(items);
+    std::vector<int> offenders = last_offenders_;
+    if (!ok) {
+      ok = try_items({other});
+      // Both neighbours imply fractional candidates: the committed roundings already doom them.
+      if (!ok && !offenders.empty() && !last_offenders_.empty()) {
+        offenders.insert(offenders.end(), last_offenders_.begin(), last_offenders_.end());
+        for (const int o : offenders)
+          if (cand_[o].is_cone) doomed_.push_back(o - cand_[o].coord);
+      }
+    }
     lopt_.homotopy_iterations = 0;
     return ok;
   }
@@ -384,6 +424,9 @@ class Rounder {
   Eigen::VectorXd x_;
   std::vector<char> decided_;
   int n_failed_ = 0;  // failed re-optimizations at this scale
+  std::vector<int> last_offenders_;  // of the last try_items that failed its parity repair
+  std::vector<int> doomed_;          // u candidates of cone copies found doomed by parity
+  std::vector<char> priority_;       // per candidate (u candidate of a cone copy): round first
   std::vector<param::AffineRow> rows_;
   param::ConstrainedReduction reduction_;
 };
@@ -540,8 +583,22 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                                       rotation_entry(s.matching, d, 1) * x[2 * s.a0 + 1];
     }
     lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
-    Rounder rounder(mesh, cl, candidates, is_cone_copy, lopt, &st);
-    const bool ok = rounder.run(x, options.threshold_step, options.progress);
+    // At one scale, a run that dead-ends on cones doomed by parity restarts with those cones
+    // rounded first (a few times), before the scale changes.
+    std::vector<char> priority(candidates.size(), 0);
+    std::optional<Rounder> found;
+    bool ok = false;
+    for (int restart = 0; restart <= kMaxPriorityRestarts; ++restart) {
+      found.emplace(mesh, cl, candidates, is_cone_copy, lopt, &st);
+      found->set_priority(priority);
+      ok = found->run(x, options.threshold_step, options.progress);
+      if (ok || !found->hard_failure_.is_ok()) break;
+      bool added = false;
+      for (const int u : found->doomed())
+        if (!priority[u]) priority[u] = added = true;
+      if (!added) break;
+    }
+    Rounder& rounder = *found;
     if (!rounder.hard_failure_.is_ok()) {
       failure = rounder.hard_failure_;
       break;
