@@ -8,6 +8,7 @@
 #include <libparam/seamless_param.h>
 #include <libquadex/extract_quads.h>
 #include <libquadex/quad_metrics.h>
+#include <libquadex/relax_quads.h>
 #include <libquantize/quantize.h>
 
 #include <Eigen/Geometry>
@@ -93,6 +94,11 @@ inline PipelineRun run_pipeline(const core::TriMesh& mesh, int target_faces) {
   if (!run.quantized.status.is_ok()) return run;
   t = Clock::now();
   run.quads = quadex::extract_quads(run.quantized.uv);
+  // As the CLI does: relax the vertices of badly shaped quads on the input surface.
+  if (run.quads.status.is_ok()) {
+    quadex::RelaxResult relaxed = quadex::relax_bad_quads(run.quads.quads, mesh);
+    if (relaxed.status.is_ok()) run.quads.quads = std::move(relaxed.quads);
+  }
   run.seconds_extract = since(t);
   return run;
 }

@@ -26,9 +26,6 @@ struct CheckArgs {
   int samples = 100'000;
 };
 
-// JSON has no infinity: a non-finite figure is written as null.
-nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
-
 bool all_triangles(const core::PolyMesh& mesh) {
   for (int f = 0; f < mesh.n_faces(); ++f)
     if (mesh.degree(f) != 3) return false;

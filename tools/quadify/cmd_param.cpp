@@ -20,19 +20,11 @@ struct ParamArgs {
   param::ParamOptions options;
 };
 
-const std::map<std::string, param::Energy> kEnergies = {
-    {"tau", param::Energy::kTau},
-    {"sd", param::Energy::kSymmetricDirichlet},
-    {"arap", param::Energy::kArap},
-    {"linf-arap", param::Energy::kLinfArap},
-    {"conformal", param::Energy::kConformal},
-};
 const std::map<std::string, param::RoundingOrder> kOrders = {
     {"bottom-up", param::RoundingOrder::kBottomUp},
     {"top-down", param::RoundingOrder::kTopDown},
 };
 
-nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 int run_param(const ParamArgs& args, const CommonOptions& common) {
   Progress progress(common.quiet);

@@ -7,6 +7,7 @@
 #include <libparam/seamless_param.h>
 #include <libquadex/extract_quads.h>
 #include <libquadex/quad_metrics.h>
+#include <libquadex/relax_quads.h>
 #include <libquantize/quantize.h>
 
 #include <algorithm>
@@ -25,20 +26,13 @@ struct RemeshArgs {
   double edge_length = 0;
   bool keep_uv = false;
   bool measure = true;
+  bool relax = true;
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
 };
 
-const std::map<std::string, param::Energy> kEnergies = {
-    {"tau", param::Energy::kTau},
-    {"sd", param::Energy::kSymmetricDirichlet},
-    {"arap", param::Energy::kArap},
-    {"linf-arap", param::Energy::kLinfArap},
-    {"conformal", param::Energy::kConformal},
-};
 
-nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
 
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   Progress progress(common.quiet);
@@ -82,6 +76,16 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   progress.end();
   if (!extracted.status.is_ok())
     throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
+  quadex::RelaxStats relax_stats;
+  if (args.relax) {
+    progress.begin("relax");
+    quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh);
+    progress.end();
+    if (!relaxed.status.is_ok())
+      throw CliError{kExitInternal, args.input + ": quad relaxation failed: " + relaxed.status.to_string()};
+    extracted.quads = std::move(relaxed.quads);
+    relax_stats = relaxed.stats;
+  }
   if (!args.keep_uv) {
     extracted.quads.uv.resize(0, 2);
     extracted.quads.face_uv.clear();
@@ -113,6 +117,13 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   const quadex::ExtractStats& es = extracted.stats;
   report["extract"] = {{"vertices", es.n_vertices}, {"faces", es.n_faces}, {"non_quads", es.n_non_quads},
                        {"boundary_crossings", es.n_boundary_crossings}, {"seconds", es.seconds}};
+  if (args.relax)
+    report["relax"] = {{"bad_before", relax_stats.n_bad_before},
+                       {"bad_after", relax_stats.n_bad_after},
+                       {"flipped_before", relax_stats.n_flipped_before},
+                       {"flipped_after", relax_stats.n_flipped_after},
+                       {"moves", relax_stats.n_moves},
+                       {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");
     quadex::QuadMetricsOptions metric_options;
@@ -176,6 +187,9 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
+  app.add_flag("!--no-relax", args->relax,
+               "Keep the extracted vertex positions (by default, vertices of quads with a corner of "
+               "scaled Jacobian below 0.2 are relaxed on the input surface)");
   app.add_flag("!--no-measure", args->measure,
                "Skip the quality measures (Hausdorff distance, scaled Jacobian) of the report");
   app.add_option("--samples", args->samples, "Area samples per surface for the Hausdorff distance")

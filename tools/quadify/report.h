@@ -4,6 +4,7 @@
 #include <libcore/mesh.h>
 #include <libcore/repair.h>
 #include <libcore/topology.h>
+#include <libparam/seamless_param.h>
 
 #include <nlohmann/json.hpp>
 
@@ -11,11 +12,25 @@
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
+#include <cmath>
+#include <map>
 #include <mutex>
 #include <string>
 #include <thread>
 
 namespace quadify::cli {
+
+// A JSON number, or null for NaN and ±inf (JSON has neither).
+inline nlohmann::json number(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(nullptr); }
+
+// Names of the distortion energies for --energy.
+inline const std::map<std::string, param::Energy> kEnergies = {
+    {"tau", param::Energy::kTau},
+    {"sd", param::Energy::kSymmetricDirichlet},
+    {"arap", param::Energy::kArap},
+    {"linf-arap", param::Energy::kLinfArap},
+    {"conformal", param::Energy::kConformal},
+};
 
 // Documented exit codes (README, --help).
 constexpr int kExitOk = 0;

@@ -1,0 +1,46 @@
+// Local repair of badly shaped quads after extraction: vertices of quads with a corner whose
+// scaled Jacobian is below a threshold (typically a reflex corner at a valence-3 cone, where the
+// integer map is most anisotropic) are moved towards the centroid of their edge neighbours and
+// projected back onto the input surface, one vertex at a time, keeping a move only when it raises
+// the worst scaled Jacobian of the quads around that vertex. Topology, UVs and boundary vertices
+// are unchanged.
+#pragma once
+
+#include <libcore/mesh.h>
+#include <libcore/status.h>
+
+namespace quadify::quadex {
+
+struct RelaxOptions {
+  // Quads whose worst corner scaled Jacobian (corner cross product against the quad's area
+  // vector, over the product of the edge lengths; 1 = right angle, ≤ 0 = reflex or flipped)
+  // is below this are repaired.
+  double min_scaled_jacobian = 0.2;
+  // Rounds over the vertices to repair (each round visits them in index order).
+  int max_rounds = 20;
+  // Vertex rings around the bad quads' vertices that may move too (room to spread the fix).
+  int rings = 1;
+};
+
+struct RelaxStats {
+  int n_bad_before = 0;  // quads below min_scaled_jacobian before
+  int n_bad_after = 0;   // and after
+  int n_flipped_before = 0, n_flipped_after = 0;  // quads with a corner scaled Jacobian ≤ 0
+  int n_moves = 0;       // accepted vertex moves
+  double seconds = 0;
+};
+
+struct RelaxResult {
+  core::Status status;
+  core::PolyMesh quads;
+  RelaxStats stats;
+};
+
+// Repairs the quads of `quads` (faces of degree ≠ 4 are left alone and do not count) whose worst
+// corner is below options.min_scaled_jacobian, moving vertices on `surface` (the input triangle
+// mesh: moved vertices are its closest points to the neighbour centroids). Deterministic.
+// Returns kInvalidInput for bad options, an empty surface or vertex ids out of range.
+[[nodiscard]] RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& surface,
+                                          const RelaxOptions& options = {});
+
+}  // namespace quadify::quadex

@@ -1,0 +1,175 @@
+#include <libquadex/relax_quads.h>
+
+#include <libcore/predicates.h>
+
+#include <Eigen/Geometry>
+
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_triangle_primitive.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <chrono>
+#include <limits>
+#include <map>
+#include <vector>
+
+namespace quadify::quadex {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Triangle = Kernel::Triangle_3;
+using TriangleIterator = std::vector<Triangle>::const_iterator;
+using TriangleTree =
+    CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>>>;
+
+// Fraction of the way to the neighbour centroid tried after the full step is refused.
+constexpr double kHalfStep = 0.5;
+// A move is kept when it raises the local worst scaled Jacobian by more than this (round-off).
+constexpr double kMinImprovement = 1e-9;
+
+// Worst corner scaled Jacobian of quad f (see RelaxOptions).
+double quad_sj(const core::PolyMesh& q, int f) {
+  std::array<Eigen::Vector3d, 4> p;
+  for (int k = 0; k < 4; ++k) p[k] = q.V.row(q.vertex(f, k)).transpose();
+  std::array<Eigen::Vector3d, 4> cross;
+  Eigen::Vector3d area = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 4; ++k) {
+    cross[k] = (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]);
+    area += cross[k];
+  }
+  const double an = area.norm();
+  if (!(an > 0)) return -1;
+  double worst = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    const double lengths = (p[(k + 1) % 4] - p[k]).norm() * (p[(k + 3) % 4] - p[k]).norm();
+    worst = std::min(worst, lengths > 0 ? cross[k].dot(area) / (an * lengths) : -1.0);
+  }
+  return worst;
+}
+
+}  // namespace
+
+RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& surface,
+                            const RelaxOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  RelaxResult res;
+  res.quads = quads;
+  if (!(options.min_scaled_jacobian <= 1) || options.max_rounds < 0 || options.rings < 0) {
+    res.status = core::Status::invalid_input("relax options: need min_scaled_jacobian ≤ 1, max_rounds ≥ 0, rings ≥ 0");
+    return res;
+  }
+  const int nv = quads.n_vertices(), nf = quads.n_faces();
+  for (int v : quads.face_vertex)
+    if (v < 0 || v >= nv) {
+      res.status = core::Status::invalid_input("quad mesh has a vertex id out of range");
+      return res;
+    }
+  std::vector<Triangle> triangles;
+  for (int f = 0; f < surface.n_faces(); ++f) {
+    const Eigen::Vector3d a = surface.V.row(surface.F(f, 0)), b = surface.V.row(surface.F(f, 1)),
+                          c = surface.V.row(surface.F(f, 2));
+    if (core::collinear3d(a, b, c)) continue;
+    triangles.emplace_back(Point(a.x(), a.y(), a.z()), Point(b.x(), b.y(), b.z()),
+                           Point(c.x(), c.y(), c.z()));
+  }
+  if (triangles.empty()) {
+    res.status = core::Status::invalid_input("relax: the surface has no non-degenerate triangle");
+    return res;
+  }
+  TriangleTree tree(triangles.begin(), triangles.end());
+  tree.accelerate_distance_queries();
+
+  // Incidence: quads per vertex, edge neighbours, boundary (an edge with one face) and
+  // non-manifold (three or more) vertices stay fixed.
+  std::vector<std::vector<int>> vertex_quads(nv), neighbours(nv);
+  std::map<std::pair<int, int>, int> edge_faces;
+  for (int f = 0; f < nf; ++f) {
+    const int d = quads.degree(f);
+    for (int k = 0; k < d; ++k) {
+      const int a = quads.vertex(f, k), b = quads.vertex(f, (k + 1) % d);
+      ++edge_faces[{std::min(a, b), std::max(a, b)}];
+      if (d == 4) vertex_quads[a].push_back(f);
+    }
+  }
+  std::vector<char> fixed(nv, 0);
+  for (const auto& [e, count] : edge_faces) {
+    neighbours[e.first].push_back(e.second);
+    neighbours[e.second].push_back(e.first);
+    if (count != 2) fixed[e.first] = fixed[e.second] = 1;
+  }
+  for (int v = 0; v < nv; ++v)
+    if (vertex_quads[v].empty()) fixed[v] = 1;
+
+  core::PolyMesh& q = res.quads;
+  auto count_bad = [&](double threshold) {
+    int n = 0;
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) == 4 && quad_sj(q, f) < threshold) ++n;
+    return n;
+  };
+  res.stats.n_bad_before = count_bad(options.min_scaled_jacobian);
+  res.stats.n_flipped_before = count_bad(std::numeric_limits<double>::min());
+  auto local_worst = [&](int v) {
+    double w = std::numeric_limits<double>::infinity();
+    for (int f : vertex_quads[v]) w = std::min(w, quad_sj(q, f));
+    return w;
+  };
+  for (int round = 0; round < options.max_rounds; ++round) {
+    // Vertices to move: those of bad quads, grown by `rings` neighbour rings.
+    std::vector<char> in_set(nv, 0);
+    std::vector<int> set;
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) == 4 && quad_sj(q, f) < options.min_scaled_jacobian)
+        for (int k = 0; k < 4; ++k)
+          if (!in_set[q.vertex(f, k)]) {
+            in_set[q.vertex(f, k)] = 1;
+            set.push_back(q.vertex(f, k));
+          }
+    if (set.empty()) break;
+    for (int r = 0; r < options.rings; ++r) {
+      const size_t n = set.size();
+      for (size_t i = 0; i < n; ++i)
+        for (int w : neighbours[set[i]])
+          if (!in_set[w]) {
+            in_set[w] = 1;
+            set.push_back(w);
+          }
+    }
+    std::sort(set.begin(), set.end());
+    int moves = 0;
+    for (int v : set) {
+      if (fixed[v]) continue;
+      const Eigen::Vector3d old = q.V.row(v).transpose();
+      const double before = local_worst(v);
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (int w : neighbours[v]) centroid += q.V.row(w).transpose();
+      centroid /= static_cast<double>(neighbours[v].size());
+      bool kept = false;
+      for (const double step : {1.0, kHalfStep}) {
+        const Eigen::Vector3d target = old + step * (centroid - old);
+        const Point p = tree.closest_point(Point(target.x(), target.y(), target.z()));
+        q.V.row(v) << p.x(), p.y(), p.z();
+        if (local_worst(v) > before + kMinImprovement) {
+          kept = true;
+          break;
+        }
+      }
+      if (kept) {
+        ++moves;
+      } else {
+        q.V.row(v) = old.transpose();
+      }
+    }
+    res.stats.n_moves += moves;
+    if (moves == 0) break;
+  }
+  res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
+  res.stats.n_flipped_after = count_bad(std::numeric_limits<double>::min());
+  res.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+}  // namespace quadify::quadex
