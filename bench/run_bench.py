@@ -119,6 +119,11 @@ COLUMNS = {
         ("flipped", "check", "check.flipped_quads"), ("sj min", "check", "check.sj_min"),
         ("manifold", "check", "check.manifold"), ("Hausdorff", "check", "check.hausdorff_sym"),
         ("feature capture", "check", "check.feature_capture"),
+        ("components", "check", "check.components"), ("genus", "check", "check.genus"),
+        ("boundary loops", "check", "check.boundary_loops"), ("cones", "run", "param.cones"),
+        ("cancelled pairs", "run", "param.cancelled_pairs"), ("tau", "run", "param.tau"),
+        ("scale restarts", "run", "quantize.scale_retries"), ("s param", "run", "timings.param"),
+        ("s quantize", "run", "timings.quantize"), ("s extract", "run", "timings.extract"),
     ],
 }
 
