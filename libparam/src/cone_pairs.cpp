@@ -55,7 +55,7 @@ struct PathSearch {
       if (l > max_length || on_boundary[st.to]) continue;
       if (std::find(visited.begin(), visited.end(), st.to) != visited.end()) continue;
       path.push_back({st.seam, st.orientation});
-      if (index[st.to] == -1) {
+      if (index[st.to] < 0) {
         found->push_back({source, st.to, l, path});
       } else if (index[st.to] == 0 && static_cast<int>(path.size()) < max_hops) {
         visited.push_back(st.to);
@@ -90,7 +90,7 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
   }
   std::vector<ConePairCancellation> candidates;
   for (int p = 0; p < nv; ++p) {
-    if (index[p] != 1 || on_boundary[p]) continue;
+    if (index[p] <= 0 || on_boundary[p]) continue;
     PathSearch search{adjacency, index, on_boundary, max_length, max_hops, p, {}, {p}, &candidates};
     search.extend(p, 0.0);
   }

@@ -39,10 +39,11 @@ struct ConePairCancellation {
 std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
                                 const Eigen::VectorXd& x);
 
-// Disjoint pairs (+1, −1) of interior cones joined by a path of at most max_hops seam edges and
-// 3D length at most max_length whose inner vertices are regular interior vertices; greedily by
-// path length (shortest first, ties by vertex ids: deterministic). Cones of |index| > 1 are left
-// alone.
+// Disjoint pairs of interior cones of opposite sign (positive_vertex > 0 > negative_vertex)
+// joined by a path of at most max_hops seam edges and 3D length at most max_length whose inner
+// vertices are regular interior vertices; greedily by path length (shortest first, ties by
+// vertex ids: deterministic). Applying a pair moves one unit of index from the positive to the
+// negative cone, so cones of |index| > 1 may take part in several passes.
 std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
                                                                const CutMesh& cut,
                                                                const std::vector<int>& index,

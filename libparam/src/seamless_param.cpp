@@ -62,6 +62,8 @@ void add_timers(const OptimizeTimers& t, ParamStats* s) {
 
 // Failed re-optimizations tolerated by the cone-pair cancellation before it keeps what it has.
 constexpr int kMaxCancellationFailures = 6;
+// Passes of the cone-pair cancellation: a cone of |index| > 1 loses one unit per pass.
+constexpr int kConePairPasses = 4;
 
 double batch_threshold(const ParamOptions& o, int i) {
   return o.order == RoundingOrder::kBottomUp ? o.threshold_step * (i + 1)
@@ -193,10 +195,13 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   // batch. A set that cannot be made flip-free is split in halves.
   if (options.cone_pair_distance > 0 && out.status.is_ok()) {
     const auto to = Clock::now();
+    int failures = 0;
+    for (int pass = 0; pass < kConePairPasses && failures < kMaxCancellationFailures; ++pass) {
     const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
         mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
         options.cone_pair_max_hops);
-    int failures = 0;
+    if (pairs.empty()) break;
+    const int cancelled_before = out.stats.n_cancelled_pairs;
     std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
       if (begin >= end || failures >= kMaxCancellationFailures) return;
       std::vector<int> new_matching = matching;
@@ -258,6 +263,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       apply(mid, end);
     };
     apply(0, pairs.size());
+    if (out.stats.n_cancelled_pairs == cancelled_before) break;
+    }
     out.stats.seconds_optimize += seconds_since(to);
   }
   if (options.energy == Energy::kTau) {
