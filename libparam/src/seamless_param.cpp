@@ -20,7 +20,6 @@
 #include <functional>
 #include <cmath>
 #include <mutex>
-#include <numbers>
 #include <stdexcept>
 
 namespace quadify::param {
@@ -323,22 +322,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                       ? std::numeric_limits<double>::infinity()
                       : std::sqrt(s1max / s2min);
   // Cones: UV angle sums at interior vertices.
-  std::vector<double> angle_sum(mesh.n_vertices(), 0.0);
-  std::vector<char> on_boundary(mesh.n_vertices(), 0);
-  for (int h = 0; h < 3 * nf; ++h)
-    if (cut.topo.twin[h] < 0) on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
-  for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d p = out.corner_uv.row(3 * f + k);
-      const Eigen::Vector2d u = Eigen::Vector2d(out.corner_uv.row(3 * f + (k + 1) % 3)) - p;
-      const Eigen::Vector2d w = Eigen::Vector2d(out.corner_uv.row(3 * f + (k + 2) % 3)) - p;
-      angle_sum[mesh.F(f, k)] += std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w));
-    }
-  for (int v = 0; v < mesh.n_vertices(); ++v) {
-    if (on_boundary[v] || angle_sum[v] == 0) continue;
-    const int index = 4 - static_cast<int>(std::lround(angle_sum[v] / (0.5 * std::numbers::pi)));
-    if (index != 0) out.cones.push_back({v, index});
-  }
+  const std::vector<int> index = vertex_indices(mesh, cut, x);
+  for (int v = 0; v < mesh.n_vertices(); ++v)
+    if (index[v] != 0) out.cones.push_back({v, index[v]});
   out.stats.n_cones = static_cast<int>(out.cones.size());
   if (out.status.is_ok() && out.stats.n_flipped > 0)
     out.status = core::Status::not_converged("seamless layout has " +

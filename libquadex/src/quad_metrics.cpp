@@ -3,6 +3,8 @@
 #include <libcore/predicates.h>
 #include <libcore/topology.h>
 
+#include "quad_corners.h"
+
 #include <CGAL/AABB_segment_primitive.h>
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
@@ -328,22 +330,15 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
   m.sj_min = nf > 0 ? 1.0 : 0.0;
   for (int f = 0; f < nf; ++f) {
     if (quads.degree(f) != 4) continue;
-    std::array<Eigen::Vector3d, 4> p;
-    for (int k = 0; k < 4; ++k) p[k] = quads.V.row(quads.vertex(f, k)).transpose();
-    std::array<Eigen::Vector3d, 4> cross;
-    Eigen::Vector3d area_vector = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) {
-      cross[k] = (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]);
-      area_vector += cross[k];
-    }
-    const double area_norm = area_vector.norm();
-    const Eigen::Vector3d n = area_norm > 0 ? Eigen::Vector3d(area_vector / area_norm) : Eigen::Vector3d::Zero();
+    const QuadCorners corners = quad_corners(quads, f);
+    const std::array<Eigen::Vector3d, 4>& p = corners.p;
+    const Eigen::Vector3d& area_vector = corners.area_vector;
     bool flipped = false;
     double quad_sj_min = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d e1 = p[(k + 1) % 4] - p[k], e2 = p[(k + 3) % 4] - p[k];
       const double lengths = e1.norm() * e2.norm();
-      const double sj = lengths > 0 ? cross[k].dot(n) / lengths : 0.0;
+      const double sj = corners.scaled_jacobian[k];
       if (sj <= 0) flipped = true;
       // Unsigned corner angle in [0°, 180°] as in the peers' table (a reflex corner reads as
       // 360° minus its interior angle; the scaled Jacobian flags it).

@@ -2,6 +2,8 @@
 
 #include <libcore/predicates.h>
 
+#include "quad_corners.h"
+
 #include <Eigen/Geometry>
 
 #include <CGAL/AABB_traits.h>
@@ -31,24 +33,7 @@ constexpr double kHalfStep = 0.5;
 constexpr double kMinImprovement = 1e-9;
 
 // Worst corner scaled Jacobian of quad f (see RelaxOptions).
-double quad_sj(const core::PolyMesh& q, int f) {
-  std::array<Eigen::Vector3d, 4> p;
-  for (int k = 0; k < 4; ++k) p[k] = q.V.row(q.vertex(f, k)).transpose();
-  std::array<Eigen::Vector3d, 4> cross;
-  Eigen::Vector3d area = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 4; ++k) {
-    cross[k] = (p[(k + 1) % 4] - p[k]).cross(p[(k + 3) % 4] - p[k]);
-    area += cross[k];
-  }
-  const double an = area.norm();
-  if (!(an > 0)) return -1;
-  double worst = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 4; ++k) {
-    const double lengths = (p[(k + 1) % 4] - p[k]).norm() * (p[(k + 3) % 4] - p[k]).norm();
-    worst = std::min(worst, lengths > 0 ? cross[k].dot(area) / (an * lengths) : -1.0);
-  }
-  return worst;
-}
+double quad_sj(const core::PolyMesh& q, int f) { return quad_corners(q, f).min_scaled_jacobian(); }
 
 }  // namespace
 

@@ -104,6 +104,23 @@ int rotation_entry(int r, int d, int j) {
   return kR[((r % 4) + 4) % 4][d][j];
 }
 
+// 3D surface area of the mesh.
+double surface_area(const core::TriMesh& mesh) {
+  double area = 0;
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
+    area += 0.5 * (Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0)
+                      .cross(Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0)
+                      .norm();
+  }
+  return area;
+}
+
+// The quad count used when neither target_faces nor edge_length is given.
+int default_target_faces(const core::TriMesh& mesh) {
+  return std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
+}
+
 double uv_area(const param::CopyLayout& cl, const Eigen::VectorXd& x, int nf) {
   double a = 0;
   for (int f = 0; f < nf; ++f) {
@@ -271,9 +288,9 @@ class Rounder {
 
   // Parity repair before any solve: while the batch implies fractional candidates, move single
   // roundings to their other neighbouring integer when that lowers the number of offenders
-  // (changing one coordinate of a ±1 cone by one flips the parity of (I − R)·x). Returns false
-  // when the offenders cannot be removed this way.
-  bool repair_parity(std::vector<Item>* items) const {
+  // (changing one coordinate of a ±1 cone by one flips the parity of (I − R)·x). Returns the
+  // offenders left (empty when the batch is parity-clean).
+  std::vector<int> repair_parity(std::vector<Item>* items) const {
     std::vector<int> offenders = offenders_of(*items);
     for (int pass = 0; pass < kParityRepairPasses && !offenders.empty(); ++pass) {
       bool improved = false;
@@ -291,16 +308,15 @@ class Rounder {
       }
       if (!improved) break;
     }
-    return offenders.empty();
+    return offenders;
   }
 
   bool try_items(std::vector<Item> items) {
-    if (!repair_parity(&items)) {
-      last_offenders_ = offenders_of(items);
+    last_offenders_ = repair_parity(&items);
+    if (!last_offenders_.empty()) {
       ++n_failed_;
       return false;
     }
-    last_offenders_.clear();
     std::vector<param::AffineRow> new_rows;
     for (const Item& it : items) new_rows.push_back(row_of(it));
     param::ConstrainedLayoutResult res =
@@ -528,13 +544,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   st.n_candidates = static_cast<int>(candidates.size());
 
   // Scale.
-  double area3d = 0;
-  for (int f = 0; f < nf; ++f) {
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
-    area3d += 0.5 * (Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0)
-                        .cross(Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0)
-                        .norm();
-  }
+  const double area3d = surface_area(mesh);
   const double area_uv = uv_area(cl, cl.x, nf);
   double scale = 0;
   if (options.target_faces > 0) {
@@ -542,7 +552,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   } else if (options.edge_length > 0) {
     scale = std::sqrt(area3d / area_uv) / options.edge_length;
   } else {
-    scale = std::sqrt(std::max(kMinDefaultQuads, nf / kDefaultTrianglesPerQuad) / area_uv);
+    scale = std::sqrt(default_target_faces(mesh) / area_uv);
   }
   if (!(scale > 0) || !std::isfinite(scale)) {
     out.status =
@@ -669,17 +679,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
 
 double target_edge_length(const core::TriMesh& mesh, const QuantizeOptions& options) {
   if (options.target_faces <= 0 && options.edge_length > 0) return options.edge_length;
-  double area3d = 0;
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
-    area3d += 0.5 * (Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0)
-                        .cross(Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0)
-                        .norm();
-  }
-  const int target = options.target_faces > 0
-                         ? options.target_faces
-                         : std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
-  return std::sqrt(area3d / target);
+  const int target = options.target_faces > 0 ? options.target_faces : default_target_faces(mesh);
+  return std::sqrt(surface_area(mesh) / target);
 }
 
 double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeOptions& options,
