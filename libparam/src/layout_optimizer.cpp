@@ -101,10 +101,23 @@ Element make_face_element(const Reduction& red, const std::array<int, 3>& fc) {
   return make_element(rows);
 }
 
-struct Problem {
+// f(begin, end) over [0, n) in chunks, in parallel with TBB; chunks are independent.
+template <typename F>
+void parallel_ranges(int n, F&& f) {
+#ifdef QUADIFY_WITH_TBB
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 1024),
+                    [&](const tbb::blocked_range<int>& r) { f(r.begin(), r.end()); });
+#else
+  f(0, n);
+#endif
+}
+
+}  // namespace
+
+struct LayoutProblem::Impl {
   const LayoutDomain& domain;
   const Reduction& red;
-  const OptimizeSettings& s;
+  const std::vector<SparseRow>* penalty_rows;
   std::vector<Element> faces, rows;
   std::vector<Eigen::VectorXd> row_coefs;  // coefficients of each penalty row (local order)
   bool dense = false;
@@ -113,9 +126,17 @@ struct Problem {
   std::vector<double> face_value;          // per-face buffers of evaluate()
   std::vector<Eigen::VectorXd> face_gy;
   std::vector<Eigen::MatrixXd> face_hy;
+  core::SparseSolver solver;  // symbolic analysis of the pattern H, reused by every optimization
+  bool analyzed = false;
+  double setup_seconds = 0;   // not yet reported by an optimization
+  int max_element_variables = 0;
+  // Column → (element, local index) incidences, elements in increasing id within a column
+  // (faces 0..#F−1, then the penalty rows).
+  std::vector<int> col_start;
+  std::vector<std::pair<int, int>> col_elements;
 
-  Problem(const LayoutDomain& d, const Reduction& r, const OptimizeSettings& st)
-      : domain(d), red(r), s(st) {
+  Impl(const LayoutDomain& d, const Reduction& r, const std::vector<SparseRow>* penalty)
+      : domain(d), red(r), penalty_rows(penalty) {
     faces.resize(d.n_faces());
     auto build = [&](int f) {
       const auto& fc = d.face_copies[f];
@@ -126,8 +147,10 @@ struct Problem {
 #else
     for (int f = 0; f < d.n_faces(); ++f) build(f);
 #endif
-    if (s.penalty_rows) {
-      for (const auto& row : *s.penalty_rows) {
+    for (const Element& el : faces)
+      max_element_variables = std::max(max_element_variables, static_cast<int>(el.ys.size()));
+    if (penalty_rows) {
+      for (const auto& row : *penalty_rows) {
         std::vector<int> xv;
         Eigen::VectorXd co(row.entries.size());
         for (size_t i = 0; i < row.entries.size(); ++i) {
@@ -144,34 +167,87 @@ struct Problem {
       Hd = Eigen::MatrixXd::Zero(n, n);
       return;
     }
-    std::vector<Eigen::Triplet<double>> trip;
-    for (int i = 0; i < n; ++i) trip.emplace_back(i, i, 0.0);
-    auto collect = [&](const Element& el) {
-      for (int a : el.ys)
-        for (int b : el.ys) trip.emplace_back(a, b, 0.0);
-    };
-    for (const auto& el : faces) collect(el);
-    for (const auto& el : rows) collect(el);
-    H.resize(n, n);
-    H.setFromTriplets(trip.begin(), trip.end());
-    H.makeCompressed();
-    auto locate = [&](Element& el) {
-      el.offsets.resize(el.ys.size() * el.ys.size());
-      for (size_t j = 0; j < el.ys.size(); ++j) {
-        const int col = el.ys[j];
-        const int* begin = H.innerIndexPtr() + H.outerIndexPtr()[col];
-        const int* end = H.innerIndexPtr() + H.outerIndexPtr()[col + 1];
-        for (size_t i = 0; i < el.ys.size(); ++i)
-          el.offsets[j * el.ys.size() + i] =
-              static_cast<int>(std::lower_bound(begin, end, el.ys[i]) - H.innerIndexPtr());
+    build_pattern(n);
+  }
+
+  const Element& element(int e) const {
+    const int nf = static_cast<int>(faces.size());
+    return e < nf ? faces[e] : rows[e - nf];
+  }
+  Element& element(int e) {
+    const int nf = static_cast<int>(faces.size());
+    return e < nf ? faces[e] : rows[e - nf];
+  }
+
+  // The pattern of H (union of the element cliques, both triangles, with the diagonal) and each
+  // element's offsets into it, column by column: Σ_e k_e² work without a triplet list, in
+  // parallel over columns (each column's entries are written by one task only).
+  void build_pattern(int n) {
+    const int n_el = static_cast<int>(faces.size() + rows.size());
+    col_start.assign(n + 1, 0);
+    for (int e = 0; e < n_el; ++e)
+      for (int v : element(e).ys) ++col_start[v + 1];
+    for (int j = 0; j < n; ++j) col_start[j + 1] += col_start[j];
+    col_elements.resize(col_start[n]);
+    {
+      std::vector<int> fill(col_start.begin(), col_start.end() - 1);
+      for (int e = 0; e < n_el; ++e) {
+        const auto& ys = element(e).ys;
+        for (int jj = 0; jj < static_cast<int>(ys.size()); ++jj)
+          col_elements[fill[ys[jj]]++] = {e, jj};
+      }
+    }
+    for (int e = 0; e < n_el; ++e) {
+      Element& el = element(e);
+      el.offsets.assign(el.ys.size() * el.ys.size(), -1);
+    }
+    std::vector<std::vector<int>> col_rows(n);
+    auto gather = [&](int j0, int j1) {
+      std::vector<char> mark(n, 0);
+      for (int j = j0; j < j1; ++j) {
+        std::vector<int>& rows_j = col_rows[j];
+        rows_j.push_back(j);
+        mark[j] = 1;
+        for (int q = col_start[j]; q < col_start[j + 1]; ++q)
+          for (int v : element(col_elements[q].first).ys)
+            if (!mark[v]) {
+              mark[v] = 1;
+              rows_j.push_back(v);
+            }
+        for (int v : rows_j) mark[v] = 0;
+        std::sort(rows_j.begin(), rows_j.end());
       }
     };
-    for (auto& el : faces) locate(el);
-    for (auto& el : rows) locate(el);
+    parallel_ranges(n, gather);
+    std::vector<int> outer(n + 1, 0);
+    for (int j = 0; j < n; ++j) outer[j + 1] = outer[j] + static_cast<int>(col_rows[j].size());
+    H.resize(n, n);
+    H.reserve(Eigen::VectorXi::Map(outer.data(), n + 1).tail(n) -
+              Eigen::VectorXi::Map(outer.data(), n + 1).head(n));
+    for (int j = 0; j < n; ++j)
+      for (int i : col_rows[j]) H.insert(i, j) = 0.0;
+    H.makeCompressed();
+    auto locate = [&](int j0, int j1) {
+      std::vector<int> pos(n, -1);
+      for (int j = j0; j < j1; ++j) {
+        const int base = H.outerIndexPtr()[j];
+        const int len = H.outerIndexPtr()[j + 1] - base;
+        for (int q = 0; q < len; ++q) pos[H.innerIndexPtr()[base + q]] = base + q;
+        for (int q = col_start[j]; q < col_start[j + 1]; ++q) {
+          const auto [e, jj] = col_elements[q];
+          Element& el = element(e);
+          const size_t k = el.ys.size();
+          for (size_t i = 0; i < k; ++i) el.offsets[jj * k + i] = pos[el.ys[i]];
+        }
+        for (int q = 0; q < len; ++q) pos[H.innerIndexPtr()[base + q]] = -1;
+      }
+    };
+    parallel_ranges(n, locate);
   }
 
   // Energy of x; with gradient g (reduced) and Hessian assembled when `derivatives`.
-  double evaluate(const Eigen::VectorXd& x, bool derivatives, Eigen::VectorXd* g) {
+  double evaluate(const OptimizeSettings& s, const Eigen::VectorXd& x, bool derivatives,
+                  Eigen::VectorXd* g) {
     double energy = 0;
     if (derivatives) {
       g->setZero(red.n_free());
@@ -240,12 +316,29 @@ struct Problem {
       energy += face_value[f];
       if (!std::isfinite(face_value[f])) return std::numeric_limits<double>::infinity();
     }
-    if (derivatives)
+    if (derivatives && dense) {
       for (int f = 0; f < nf; ++f) scatter(faces[f], face_gy[f], face_hy[f]);
+    } else if (derivatives) {
+        // By column, faces in increasing order within each: parallel and deterministic.
+        double* vals = H.valuePtr();
+        parallel_ranges(red.n_free(), [&](int j0, int j1) {
+          for (int j = j0; j < j1; ++j)
+            for (int q = col_start[j]; q < col_start[j + 1]; ++q) {
+              const auto [e, jj] = col_elements[q];
+              if (e >= nf) break;  // penalty rows follow the faces: scattered below
+              const Element& el = faces[e];
+              const size_t k = el.ys.size();
+              (*g)[j] += face_gy[e][jj];
+              const double* hcol = face_hy[e].data() + jj * k;
+              const int* off = el.offsets.data() + jj * k;
+              for (size_t i = 0; i < k; ++i) vals[off[i]] += hcol[i];
+            }
+        });
+    }
     for (size_t i = 0; i < rows.size(); ++i) {
       const Eigen::VectorXd& co = row_coefs[i];
       double rv = 0;
-      for (Eigen::Index j = 0; j < co.size(); ++j) rv += co[j] * x[(*s.penalty_rows)[i].entries[j].first];
+      for (Eigen::Index j = 0; j < co.size(); ++j) rv += co[j] * x[(*penalty_rows)[i].entries[j].first];
       energy += s.penalty_weight * rv * rv;
       if (!derivatives) continue;
       const Element& el = rows[i];
@@ -255,6 +348,8 @@ struct Problem {
     return energy;
   }
 };
+
+namespace {
 
 // Largest t in (0, 1] such that det(X + t·dX) stays positive for every face positive now.
 double max_flip_free_step(const LayoutDomain& domain, const Eigen::VectorXd& x,
@@ -327,20 +422,39 @@ Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd
   return out;
 }
 
+LayoutProblem::LayoutProblem(const LayoutDomain& domain, const Reduction& red,
+                             const std::vector<SparseRow>* penalty_rows) {
+  const auto t0 = Clock::now();
+  impl_ = std::make_unique<Impl>(domain, red, penalty_rows);
+  impl_->setup_seconds = seconds_since(t0);
+}
+LayoutProblem::~LayoutProblem() = default;
+LayoutProblem::LayoutProblem(LayoutProblem&&) noexcept = default;
+LayoutProblem& LayoutProblem::operator=(LayoutProblem&&) noexcept = default;
+
+const Reduction& LayoutProblem::reduction() const { return impl_->red; }
+
 OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
                                const OptimizeSettings& settings, Eigen::VectorXd* y) {
+  LayoutProblem problem(domain, red, settings.penalty_rows);
+  return optimize_layout(problem, settings, y);
+}
+
+OptimizeReport optimize_layout(LayoutProblem& problem, const OptimizeSettings& settings,
+                               Eigen::VectorXd* y) {
   OptimizeReport rep;
-  auto tc = Clock::now();
-  Problem prob(domain, red, settings);
-  rep.timers.setup += seconds_since(tc);
+  LayoutProblem::Impl& prob = *problem.impl_;
+  const LayoutDomain& domain = prob.domain;
+  const Reduction& red = prob.red;
+  rep.timers.setup += prob.setup_seconds;  // reported once, by the first optimization
+  prob.setup_seconds = 0;
   rep.hessian_nonzeros = prob.dense ? 0 : prob.H.nonZeros();
-  for (const Element& el : prob.faces)
-    rep.max_element_variables = std::max(rep.max_element_variables, static_cast<int>(el.ys.size()));
+  rep.max_element_variables = prob.max_element_variables;
   const int n = red.n_free();
   Eigen::VectorXd x = red.expand(*y);
   Eigen::VectorXd g;
-  tc = Clock::now();
-  double energy = prob.evaluate(x, true, &g);
+  auto tc = Clock::now();
+  double energy = prob.evaluate(settings, x, true, &g);
   rep.timers.assembly += seconds_since(tc);
   rep.initial_energy = energy;
   if (!std::isfinite(energy)) {
@@ -352,8 +466,8 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
     rep.energy = energy;
     return rep;
   }
-  core::SparseSolver solver;
-  bool analyzed = false;
+  core::SparseSolver& solver = prob.solver;
+  bool& analyzed = prob.analyzed;
   for (int it = 0; it < settings.max_iterations; ++it) {
     // Newton direction with the PSD-projected Hessian (+ a tiny shift for the rotation mode).
     Eigen::VectorXd dy;
@@ -401,7 +515,7 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
     int bt = 0;
     for (; bt < kMaxBacktracks; ++bt, alpha *= 0.5) {
       x_trial = x + alpha * dx;
-      trial = prob.evaluate(x_trial, false, nullptr);
+      trial = prob.evaluate(settings, x_trial, false, nullptr);
       if (trial <= energy - kArmijo * alpha * decrement) break;
     }
     rep.timers.line_search += seconds_since(tc);
@@ -411,7 +525,7 @@ OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
     ++rep.iterations;
     const double previous = energy;
     tc = Clock::now();
-    energy = prob.evaluate(x, true, &g);
+    energy = prob.evaluate(settings, x, true, &g);
     rep.timers.assembly += seconds_since(tc);
     if (previous - energy <= 1e-3 * settings.relative_tolerance * std::abs(previous)) break;
   }
@@ -500,14 +614,15 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
     x_best = rep.reduction.expand(y_new);
     best_flips = count_flipped(domain, x_best);
   }
+  std::unique_ptr<LayoutProblem> penalty_problem;  // shared by the penalty stages
   for (double w = kFirstPenalty; w <= kLastPenalty && best_flips > 0; w *= kPenaltyGrowth) {
     if (max_residual(x_cur) > residual_tol) {
       OptimizeSettings st;
       st.max_iterations = kPenaltyIterations;
       st.relative_tolerance = kPenaltyTolerance;
-      st.penalty_rows = &new_rows;
       st.penalty_weight = w * weight_unit;
-      const OptimizeReport r = optimize_layout(domain, old_red, st, &y_old);
+      if (!penalty_problem) penalty_problem = std::make_unique<LayoutProblem>(domain, old_red, &new_rows);
+      const OptimizeReport r = optimize_layout(*penalty_problem, st, &y_old);
       rep.iterations += r.iterations;
       rep.timers += r.timers;
       if (!r.status.is_ok()) {

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace quadify::param {
@@ -71,6 +72,31 @@ struct OptimizeReport {
 // accepted by Armijo backtracking. Uses core::SparseSolver, or a dense Cholesky for small problems.
 OptimizeReport optimize_layout(const LayoutDomain& domain, const Reduction& red,
                                const OptimizeSettings& settings, Eigen::VectorXd* y);
+
+// The structure of the energy over one reduction: per-face maps to the reduced variables, the
+// reduced Hessian's pattern and its symbolic factorization. Building it costs Σ_f k_f² for
+// elements of k_f reduced variables (large near cones once every matching is fixed), so
+// optimizations that share the reduction and penalty rows — with other densities, powers or
+// penalty weights — share one LayoutProblem. `domain`, `red` and `*penalty_rows` must outlive it.
+class LayoutProblem {
+ public:
+  LayoutProblem(const LayoutDomain& domain, const Reduction& red,
+                const std::vector<SparseRow>* penalty_rows = nullptr);
+  ~LayoutProblem();
+  LayoutProblem(LayoutProblem&&) noexcept;
+  LayoutProblem& operator=(LayoutProblem&&) noexcept;
+  const Reduction& reduction() const;
+  struct Impl;
+
+ private:
+  friend OptimizeReport optimize_layout(LayoutProblem&, const OptimizeSettings&, Eigen::VectorXd*);
+  std::unique_ptr<Impl> impl_;
+};
+
+// optimize_layout over a prepared problem; settings.penalty_rows is ignored (the problem's rows
+// count, weighted by settings.penalty_weight).
+OptimizeReport optimize_layout(LayoutProblem& problem, const OptimizeSettings& settings,
+                               Eigen::VectorXd* y);
 
 // Per-face densities ψ(J_f) of the layout x (2·#copies); +inf for a barrier density at a flip.
 Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd& x,

@@ -85,6 +85,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
   ConstraintEliminator elim(n_vars, gauge);
   Reduction red = elim.reduction(x);
+  std::unique_ptr<LayoutProblem> red_problem;  // energy structure over red (reset with red)
   const int n_seams = static_cast<int>(cut.seams.size());
   std::vector<int> matching(n_seams, INT_MIN);  // INT_MIN: not rounded yet
   double total_area = 0;
@@ -167,7 +168,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     out.stats.total_iterations += tr.iterations;
     out.stats.n_transition_iterations += tr.iterations;
     add_timers(tr.timers, &out.stats);
+    red_problem.reset();
     red = std::move(tr.reduction);
+    red_problem = std::make_unique<LayoutProblem>(domain, red);
     if (!tr.status.is_ok()) {
       out.status = tr.status;
     }
@@ -179,7 +182,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // With kTau the L^p continuation follows and converges the final layout.
     st.relative_tolerance =
         last && options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
-    const OptimizeReport rep = optimize_layout(domain, red, st, &y);
+    const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
     out.stats.total_iterations += rep.iterations;
     out.stats.n_batch_iterations += rep.iterations;
     add_timers(rep.timers, &out.stats);
@@ -250,6 +253,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       if (ok) {
         matching = std::move(new_matching);
         elim = std::move(full);
+        red_problem.reset();
         red = std::move(tr.reduction);
         x = std::move(x_try);
         out.stats.n_cancelled_pairs += static_cast<int>(end - begin);
@@ -268,6 +272,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   if (options.energy == Energy::kTau) {
     const auto to = Clock::now();
+    if (!red_problem) red_problem = std::make_unique<LayoutProblem>(domain, red);
     for (double p : kTauPowers) {
       if (options.progress) options.progress("tau", static_cast<int>(p), 16);
       Eigen::VectorXd y = red.restrict(x);
@@ -276,7 +281,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.power = p;
       st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
       st.relative_tolerance = kFinalTolerance;
-      const OptimizeReport rep = optimize_layout(domain, red, st, &y);
+      const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
       add_timers(rep.timers, &out.stats);

@@ -184,6 +184,54 @@ TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
   EXPECT_LT(worst, 1e-12);
 }
 
+// One LayoutProblem reused over a sequence of optimizations (other densities and powers, as the τ
+// continuation runs them) gives bit-identical layouts to building the problem for each one.
+TEST(LayoutOptimizer, ReusedProblemMatchesFreshProblems) {
+  const core::TriMesh m = test::make_icosphere(3);  // sparse mode: > 250 reduced variables
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  const LayoutDomain dom = make_domain(cut);
+  Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
+  std::vector<char> gauge(x.size(), 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator elim(static_cast<int>(x.size()), gauge);
+  const Reduction red0 = elim.reduction(x);
+  const auto meas = measure_matchings(cut, isometric_unfold(m, cut));
+  std::vector<SparseRow> rows;
+  double edge_sq = 0, area = 0;
+  for (size_t s = 0; s < cut.seams.size(); ++s) {
+    for (const auto& r : seam_constraint_rows(cut, static_cast<int>(s), std::lround(meas[s]))) {
+      elim.add_row(r);
+      rows.push_back(r);
+    }
+    edge_sq += seam_length(cut, static_cast<int>(s)) * seam_length(cut, static_cast<int>(s));
+  }
+  for (double a : cut.area) area += a;
+  TransitionReport tr = move_into_constraints(dom, red0, elim, rows, area / edge_sq, &x);
+  ASSERT_TRUE(tr.status.is_ok()) << tr.status.to_string();
+  ASSERT_GT(tr.reduction.n_free(), 250);
+  std::vector<OptimizeSettings> sequence(4);
+  sequence[1].density = Density::kPowerSD;
+  sequence[1].power = 2;
+  sequence[2].density = Density::kPowerSD;
+  sequence[2].power = 8;
+  sequence[3].density = Density::kArap;
+  for (OptimizeSettings& st : sequence) st.max_iterations = 8;
+  Eigen::VectorXd y_fresh = tr.reduction.restrict(x), y_reused = y_fresh;
+  LayoutProblem problem(dom, tr.reduction);
+  for (const OptimizeSettings& st : sequence) {
+    const OptimizeReport fresh = optimize_layout(dom, tr.reduction, st, &y_fresh);
+    const OptimizeReport reused = optimize_layout(problem, st, &y_reused);
+    ASSERT_TRUE(fresh.status.is_ok()) << fresh.status.to_string();
+    ASSERT_TRUE(reused.status.is_ok()) << reused.status.to_string();
+    EXPECT_EQ(fresh.iterations, reused.iterations);
+    EXPECT_EQ(fresh.hessian_nonzeros, reused.hessian_nonzeros);
+    EXPECT_GT(reused.hessian_nonzeros, 0);
+    EXPECT_EQ(fresh.energy, reused.energy);
+    ASSERT_EQ((y_fresh - y_reused).cwiseAbs().maxCoeff(), 0.0);
+  }
+  EXPECT_EQ(count_flipped(dom, tr.reduction.expand(y_reused)), 0);
+}
+
 TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
   // Cube corner (defect π/2): the seam measures ±1 exactly. Perturb the layout so that the measure
   // is ambiguous is not needed: ask for a choice given a measure of 0.5 (between 0 and 1 in the
