@@ -20,7 +20,7 @@ constexpr const char* kFooter = R"(Typical use:
   quadify bunny.stl -o bunny_quads.obj --target-faces 5000   remesh (OBJ, glTF or GLB out)
   quadify info scan.ply                                      what the file holds, what repair does
   quadify check result.obj --reference bunny.stl             quality of any quad mesh or UV map
-  quadify compare --inputs meshes --outputs a=out_a --outputs b=out_b -o cmp   tools side by side
+  quadify compare --inputs in --outputs a=A --outputs b=B -o cmp   tools A, B side by side on in/*
 
 Exit codes:
   0  success
