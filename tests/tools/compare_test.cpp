@@ -204,6 +204,8 @@ TEST_F(CompareTest, BadInputIsExit2WithoutOutput) {
       {"--inputs " + shell_quoted(fx.inputs) + " --outputs =x" + out, "NAME=DIR"},
       {"--inputs " + shell_quoted(fx.inputs) + " --outputs x=" + shell_quoted(dir_ / "no_tool") + out, "no_tool"},
       {"--inputs " + shell_quoted(fx.inputs) + tool + tool + out, "twice"},
+      {"--inputs " + shell_quoted(fx.inputs) + " --outputs " + shell_quoted("a/b=" + fx.tool_dirs[0].string()) + out,
+       "NAME may hold"},
       {"--inputs " + shell_quoted(fx.inputs) + tool + " --only cube,nosuch" + out, "nosuch"},
   };
   for (const auto& c : cases) {

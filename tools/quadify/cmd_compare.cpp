@@ -22,6 +22,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -213,6 +214,10 @@ ModelResult compare_model(const Model& model, const std::vector<Tool>& tools, co
     reference = repaired.mesh;
   } catch (const core::InputError& e) {
     result.input_error = e.what();
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    result.input_error = model.path.string() + ": " + e.what();
   }
   const Camera camera = camera_for_bbox(reference.V, kPictureWidth, kPictureHeight);
   SvgStyle style;
@@ -253,6 +258,10 @@ ModelResult compare_model(const Model& model, const std::vector<Tool>& tools, co
       row.status = "ok";
     } catch (const core::InputError& e) {
       row.status = std::string("error: ") + e.what();
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::exception& e) {  // one bad output must not end the whole benchmark
+      row.status = "error: " + row.file.string() + ": " + e.what();
     }
   };
 #ifdef QUADIFY_WITH_TBB
@@ -616,6 +625,8 @@ std::vector<Tool> parse_tools(const std::vector<std::string>& specs) {
     Tool tool;
     tool.name = spec.substr(0, eq);
     tool.dir = spec.substr(eq + 1);
+    if (file_token(tool.name) != tool.name)
+      throw CliError{kExitBadInput, "--outputs " + spec + ": NAME may hold only letters, digits, '-', '_' and '.'"};
     if (!names.insert(tool.name).second)
       throw CliError{kExitBadInput, "--outputs " + spec + ": the name '" + tool.name + "' is given twice"};
     std::error_code ec;
