@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs what quadify needs and is missing: Debian packages (apt-get, non-interactive; sudo only
-# when not root) and the Khronos glTF validator (npm, into .deps/npm of this checkout, for tests).
+# when not root) and, for tests, the Khronos glTF validator (npm, into .deps/npm of this checkout)
+# and headless Chromium (screenshots of `quadify compare` pages).
 # Usage: scripts/install_deps.sh [--with-test-tools]
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -14,7 +15,7 @@ packages=(
 with_test_tools=0
 [[ "${1:-}" == "--with-test-tools" ]] && with_test_tools=1
 if (( with_test_tools )); then
-  packages+=(nodejs python3)
+  packages+=(nodejs python3 chromium)
   command -v npm >/dev/null 2>&1 || packages+=(npm)
 fi
 
@@ -26,11 +27,12 @@ fi
 
 missing=()
 for p in "${packages[@]}"; do
-  # nodejs/npm may come from another source than Debian: accept them when on PATH.
+  # nodejs/npm/chromium may come from another source than Debian: accept them when on PATH.
   case "$p" in
     nodejs) command -v node >/dev/null 2>&1 && continue ;;
     npm) command -v npm >/dev/null 2>&1 && continue ;;
     python3) command -v python3 >/dev/null 2>&1 && continue ;;
+    chromium) command -v chromium >/dev/null 2>&1 || command -v chromium-browser >/dev/null 2>&1 && continue ;;
   esac
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done

@@ -1,6 +1,6 @@
 // The CLI as a user meets it: exit codes, one-line errors that name the file, reports, and no
 // partial output on failure.
-#include "test_util.h"
+#include "cli_run.h"
 
 #include <gtest/gtest.h>
 
@@ -20,33 +20,10 @@ using quadify::test::make_temp_dir;
 
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-// Runs `quadify <args>` with stdout/stderr captured to files of `dir`.
-CliRun quadify(const std::string& args, const fs::path& dir) {
-  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  std::string cmd = "'";  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
-  cmd.append(cli_path()).append("' ").append(args).append(" >'").append(out.string());
-  cmd.append("' 2>'").append(err.string()).append("'");
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = slurp(out);
-  r.err = slurp(err);
-  return r;
-}
-
-void write_text(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+using quadify::test::CliRun;
+using quadify::test::quadify;
+using quadify::test::slurp;
+using quadify::test::write_text;
 
 // Unit cube, 8 vertices, 12 triangles, outward CCW.
 const char* kCubeTriObj = R"(v 0 0 0

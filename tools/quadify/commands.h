@@ -16,5 +16,6 @@ CommandRunner register_info(CLI::App& app);
 CommandRunner register_check(CLI::App& app);
 CommandRunner register_param(CLI::App& app);
 CommandRunner register_remesh(CLI::App& app);
+CommandRunner register_compare(CLI::App& app);
 
 }  // namespace quadify::cli

@@ -1,4 +1,4 @@
-// quadify: triangle mesh → quad mesh. Subcommands: remesh (the default), info, check, param. Exit codes: 0 ok, 2 bad input, 1 internal failure.
+// quadify: triangle mesh → quad mesh. Subcommands: remesh (the default), info, check, param, compare. Exit codes: 0 ok, 2 bad input, 1 internal failure.
 #include "commands.h"
 
 #include <libcore/status.h>
@@ -20,6 +20,7 @@ constexpr const char* kFooter = R"(Typical use:
   quadify bunny.stl -o bunny_quads.obj --target-faces 5000   remesh (OBJ, glTF or GLB out)
   quadify info scan.ply                                      what the file holds, what repair does
   quadify check result.obj --reference bunny.stl             quality of any quad mesh or UV map
+  quadify compare --inputs in --outputs a=A --outputs b=B -o cmp   tools A, B side by side on in/*
 
 Exit codes:
   0  success
@@ -60,11 +61,14 @@ int main(int argc, char** argv) {
   add("param", "Seamless parametrization (Levi 2021) written as a UV OBJ", cli::register_param);
   add("remesh", "Triangle mesh to quad mesh (the default: `quadify IN -o OUT` means `quadify remesh IN -o OUT`)",
       cli::register_remesh);
+  add("compare",
+      "Feature benchmark: several tools' quad meshes of a folder of inputs, measured and pictured side by side",
+      cli::register_compare);
 
   // `quadify IN -o OUT` is `quadify remesh IN -o OUT`: insert the subcommand when none is named.
   std::vector<std::string> args(argv + 1, argv + argc);
   const bool names_subcommand = std::any_of(args.begin(), args.end(), [&](const std::string& a) {
-    return a == "info" || a == "check" || a == "param" || a == "remesh";
+    return a == "info" || a == "check" || a == "param" || a == "remesh" || a == "compare";
   });
   const bool only_global = std::all_of(args.begin(), args.end(), [](const std::string& a) {
     return a == "-h" || a == "--help" || a == "--version";
