@@ -258,6 +258,16 @@ TEST_F(CliTest, RemeshOnBrokenInputWritesNothing) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+// A path that spells a subcommand stays a path: only the first word names the subcommand.
+TEST_F(CliTest, OutputNamedLikeASubcommandIsAPath) {
+  std::string args;
+  args.append("'").append((dir_ / "nope.obj").string()).append("' -o info --quiet");
+  const CliRun r = quadify(args, dir_);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("nope.obj"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "info"));
+}
+
 TEST_F(CliTest, ParamOnBrokenInputWritesNothing) {
   write_text(dir_ / "bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");  // truncated
   const fs::path out = dir_ / "out.obj";

@@ -67,9 +67,19 @@ int main(int argc, char** argv) {
 
   // `quadify IN -o OUT` is `quadify remesh IN -o OUT`: insert the subcommand when none is named.
   std::vector<std::string> args(argv + 1, argv + argc);
-  const bool names_subcommand = std::any_of(args.begin(), args.end(), [&](const std::string& a) {
-    return a == "info" || a == "check" || a == "param" || a == "remesh" || a == "compare";
-  });
+  // The subcommand is the first word that is neither an option nor the value of a global option
+  // taking one (so an input or output path that happens to be called `info` stays a path).
+  bool names_subcommand = false;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--json" || a == "--threads") {
+      ++i;
+      continue;
+    }
+    if (a.empty() || a[0] == '-') continue;
+    names_subcommand = a == "info" || a == "check" || a == "param" || a == "remesh" || a == "compare";
+    break;
+  }
   const bool only_global = std::all_of(args.begin(), args.end(), [](const std::string& a) {
     return a == "-h" || a == "--help" || a == "--version";
   });
