@@ -18,6 +18,7 @@
 #include <chrono>
 #include <climits>
 #include <functional>
+#include <iterator>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -34,8 +35,10 @@ double seconds_since(Clock::time_point t0) {
 // steer the next matchings, the final layouts are converged further.
 constexpr double kBatchTolerance = 1e-5;
 constexpr double kFinalTolerance = 1e-8;
-// Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau.
-constexpr double kTauPowers[] = {2, 4, 8, 16};
+// Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau. Going on
+// to 64 after 16 lowered τ by 5–10% (spot 1.525 → 1.405, casting 1.536 → 1.466, elk 1.564 →
+// 1.460, dilo 1.956 → 1.791) for about 25% more Newton iterations; 128 and 256 gained < 2% more.
+constexpr double kTauPowers[] = {2, 4, 8, 16, 32, 64};
 // Newton iterations per continuation stage: each stage only needs to move the maximum, and
 // the stages follow each other closely.
 constexpr int kTauStageIterations = 15;
@@ -274,7 +277,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     const auto to = Clock::now();
     if (!red_problem) red_problem = std::make_unique<LayoutProblem>(domain, red);
     for (double p : kTauPowers) {
-      if (options.progress) options.progress("tau", static_cast<int>(p), 16);
+      if (options.progress) options.progress("tau", static_cast<int>(p), static_cast<int>(std::end(kTauPowers)[-1]));
       Eigen::VectorXd y = red.restrict(x);
       OptimizeSettings st;
       st.density = Density::kPowerSD;

@@ -57,7 +57,7 @@ struct ParamOptions {
   // OpenMP/BLAS threads are not governed by it.)
   int threads = 0;
   // Optional progress callback (stage "round": batch step of n_steps; stage "tau": exponent of
-  // the L^p continuation, out of 16). Calls are serialized, but with several components they may
+  // the L^p continuation, out of 64). Calls are serialized, but with several components they may
   // come from worker threads.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
 };
