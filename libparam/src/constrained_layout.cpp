@@ -790,6 +790,32 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   return core::Status::ok();
 }
 
+bool PinnedLayout::determined_faces_valid(
+    const std::vector<std::pair<int, double>>& targets) const {
+  const Impl& m = *impl_;
+  std::vector<char> target(m.n(), 0);
+  Eigen::VectorXd y_target = m.y;
+  for (const auto& [j, value] : targets) {
+    if (j < 0 || j >= m.n()) return false;
+    target[j] = 1;
+    y_target[j] = value;
+  }
+  const Eigen::VectorXd x_target = m.red.expand(y_target);
+  for (int f = 0; f < m.domain.n_faces(); ++f) {
+    bool determined = true, moved = false;
+    for (const int j : m.faces[f].ys) {
+      determined = determined && (m.state[j] == 1 || target[j]);
+      moved = moved || target[j];
+    }
+    if (!determined || !moved) continue;
+    const auto& fc = m.domain.face_copies[f];
+    if (core::orient2d(x_target.segment<2>(2 * fc[0]), x_target.segment<2>(2 * fc[1]),
+                       x_target.segment<2>(2 * fc[2])) <= 0)
+      return false;
+  }
+  return true;
+}
+
 int PinnedLayout::minimize(int max_iterations, double relative_tolerance, core::Status* status) {
   Impl& m = *impl_;
   *status = core::Status::ok();

@@ -320,12 +320,21 @@ class Rounder {
                      [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
     std::map<int, Eigen::Vector2d> pick;
     std::map<GridKey, int> taken;
+    std::vector<std::pair<int, double>> picked_targets;
     for (const auto& [d, i, g] : pairs) {
       if (pick.count(i)) continue;
       const GridKey k = key(cones_[i], g.x(), g.y());
       if (const auto it = taken.find(k);
           it != taken.end() && cl_.copy_vertex[cones_[it->second].copy] != cl_.copy_vertex[cones_[i].copy])
         continue;
+      if (cluster) {
+        // Cones of one triangle must take a positively oriented lattice triangle.
+        std::vector<std::pair<int, double>> trial = picked_targets;
+        if (!layout_.is_pinned(cones_[i].col_u)) trial.push_back({cones_[i].col_u, g.x()});
+        if (!layout_.is_pinned(cones_[i].col_v)) trial.push_back({cones_[i].col_v, g.y()});
+        if (!layout_.determined_faces_valid(trial)) continue;
+        picked_targets = std::move(trial);
+      }
       pick[i] = g;
       taken[k] = i;
     }
@@ -354,12 +363,17 @@ class Rounder {
       ++stats_->n_cone_collisions;
       bool placed = false;
       const std::vector<Eigen::Vector2d> choices = grid_choices(c);
-      for (size_t a = 0; a < choices.size() && a < kConeAlternatives && !placed; ++a) {
+      size_t tried = 0;
+      for (size_t a = 0; a < choices.size() && tried < kConeAlternatives && !placed; ++a) {
         if (out_of_time()) return Outcome::kOutOfTime;
-        ++stats_->n_reverted;
         std::vector<std::pair<int, double>> t;
         if (!layout_.is_pinned(c.col_u)) t.push_back({c.col_u, choices[a].x()});
         if (!layout_.is_pinned(c.col_v)) t.push_back({c.col_v, choices[a].y()});
+        // A grid point that leaves a triangle of pinned cones flat or reversed is skipped
+        // without a solve (e.g. a third cone of a triangle of cones on the line of the other two).
+        if (!layout_.determined_faces_valid(t)) continue;
+        ++tried;
+        ++stats_->n_reverted;
         pin(t, cluster);
         if (!status_.is_ok()) return Outcome::kFailed;
         placed = layout_.is_pinned(c.col_u) && layout_.is_pinned(c.col_v);

@@ -193,6 +193,10 @@ class PinnedLayout {
   PinReport pin(const std::vector<std::pair<int, double>>& targets, const PinSettings& settings,
                 int relax_iterations, double relax_tolerance);
 
+  // Whether pinning `targets` (on top of the pinned variables) keeps every face that they alone
+  // determine positively oriented (exact predicate); pin() drops targets that fail this.
+  bool determined_faces_valid(const std::vector<std::pair<int, double>>& targets) const;
+
   // Flip-free Newton minimisation of the energy over the unpinned variables. Returns the number
   // of iterations; *status is kNumericalFailure when a factorization fails.
   int minimize(int max_iterations, double relative_tolerance, core::Status* status);
