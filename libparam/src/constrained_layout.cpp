@@ -1,16 +1,28 @@
 #include <libcore/topology.h>
 #include <libparam/constrained_layout.h>
 
+#include <libcore/predicates.h>
+#include <libcore/sparse_solver.h>
+
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+
+#ifdef QUADIFY_WITH_TBB
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
+#include <array>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <stdexcept>
 #include <string>
 
 #include "constraint_elimination.h"
+#include "distortion_energy.h"
 #include "cut_layout.h"
 #include "layout_optimizer.h"
 
@@ -355,6 +367,742 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   res.reduction.P = std::move(P);
   for (int v : red.free_vars) res.reduction.free_vars.push_back(ext_of[v]);
   return res;
+}
+
+}  // namespace quadify::param
+
+namespace quadify::param {
+namespace {
+
+// P holds sums of products of small integers; anything this small is cancellation round-off.
+constexpr double kPinCancelled = 1e-12;
+// Fraction of the largest flip-free step taken, so triangles keep a positive area.
+constexpr double kPinStepFraction = 0.8;
+// Armijo constant and halvings of the energy line search.
+constexpr double kPinArmijo = 1e-4;
+constexpr int kPinBacktracks = 40;
+// Halvings of a prescribed step that the exact predicate found flipped (round-off at the bound).
+constexpr int kPinExactHalvings = 10;
+// Diagonal shift relative to the mean Hessian diagonal (the global rotation is a null mode).
+constexpr double kPinRegularization = 1e-9;
+// Below this many faces the per-face evaluation runs serially.
+constexpr int kPinParallelMinFaces = 2048;
+// Consecutive stalled steps of PinnedLayout::pin before the blocking targets are dropped.
+constexpr int kStalledSteps = 2;
+// Exponent of the L^p ARAP density for Energy::kLinfArap (as in compute_seamless_param).
+constexpr double kPinLinfArapPower = 8;
+// Newton stop of a penalty stage (fraction of the energy).
+constexpr double kPinStageTolerance = 1e-8;
+// A penalty stage counts as progress for a target when its residual shrinks below this fraction.
+constexpr double kPinShrink = 0.5;
+// A target whose residual after the homotopy is above this fraction of its initial distance
+// is held back by the barrier (it blocks).
+constexpr double kPinHeldBack = 0.05;
+
+// Smallest positive t with det(X + t·D) = 0 (+inf when the orientation never changes).
+double flip_root(const Eigen::Matrix2d& X, const Eigen::Matrix2d& D) {
+  const double c0 = X.determinant();
+  const double c2 = D.determinant();
+  const double c1 = X(0, 0) * D(1, 1) + D(0, 0) * X(1, 1) - X(0, 1) * D(1, 0) - D(0, 1) * X(1, 0);
+  double root = std::numeric_limits<double>::infinity();
+  if (c2 == 0) {
+    if (c1 < 0) root = -c0 / c1;
+  } else {
+    const double disc = c1 * c1 - 4 * c2 * c0;
+    if (disc >= 0) {
+      const double sq = std::sqrt(disc);
+      const double q = -0.5 * (c1 + (c1 >= 0 ? sq : -sq));
+      const double r1 = q / c2, r2 = q != 0 ? c0 / q : std::numeric_limits<double>::infinity();
+      if (r1 > 0) root = std::min(root, r1);
+      if (r2 > 0) root = std::min(root, r2);
+    }
+  }
+  return root;
+}
+
+}  // namespace
+
+struct PinnedLayout::Impl {
+  struct Face {
+    std::vector<int> ys;                             // reduced variables of the face
+    Eigen::Matrix<double, 4, Eigen::Dynamic> M;      // edge-vector coordinates = M·y[ys]
+    std::vector<int> offsets;                        // ys² positions in H's value array
+  };
+  LayoutDomain domain;
+  Reduction red;                  // internal variables
+  ConstrainedReduction ext;       // external order
+  std::vector<int> ext_to_int;
+  std::vector<Face> faces;
+  Eigen::SparseMatrix<double> H;  // fixed pattern, both triangles
+  std::vector<int> diag_offset;
+  core::SparseSolver solver;
+  Density density = Density::kSymmetricDirichlet;
+  double power = 1;
+  Eigen::VectorXd y, x;           // reduced and internal full variables
+  std::vector<char> state;        // per reduced variable: 0 free, 1 pinned, 2 prescribed
+  // Quadratic penalty w·Σ (y_j − target)² of PinnedLayout::pin's homotopy (free variables).
+  std::vector<std::pair<int, double>> penalty;
+  double penalty_weight = 0;
+  std::vector<double> face_value;
+  std::vector<Eigen::VectorXd> face_g;
+  std::vector<Eigen::MatrixXd> face_h;
+
+  int n() const { return red.n_free(); }
+
+  template <class F>
+  void for_faces(F&& work) {
+    const int nf = domain.n_faces();
+#ifdef QUADIFY_WITH_TBB
+    if (nf >= kPinParallelMinFaces) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, nf, 256),
+                        [&](const tbb::blocked_range<int>& r) {
+                          for (int f = r.begin(); f < r.end(); ++f) work(f);
+                        });
+      return;
+    }
+#endif
+    for (int f = 0; f < nf; ++f) work(f);
+  }
+
+  Eigen::Matrix2d edge_matrix(const Eigen::VectorXd& xx, int f) const {
+    const auto& fc = domain.face_copies[f];
+    Eigen::Matrix2d X;
+    for (int d = 0; d < 2; ++d) {
+      X(d, 0) = xx[2 * fc[1] + d] - xx[2 * fc[0] + d];
+      X(d, 1) = xx[2 * fc[2] + d] - xx[2 * fc[0] + d];
+    }
+    return X;
+  }
+
+  // Energy at xx; with derivatives: gradient g (0 at non-free variables) and H (identity rows
+  // and columns at non-free variables). With v: Hv = H_full·v on the free rows.
+  double evaluate(const Eigen::VectorXd& xx, bool derivatives, Eigen::VectorXd* g,
+                  const Eigen::VectorXd* v = nullptr, Eigen::VectorXd* Hv = nullptr) {
+    const int nf = domain.n_faces();
+    face_value.resize(nf);
+    if (derivatives) {
+      face_g.resize(nf);
+      face_h.resize(nf);
+    }
+    for_faces([&](int f) {
+      const Eigen::Matrix2d J = edge_matrix(xx, f) * domain.rest_inverse[f];
+      const DensityEval ev = evaluate_density(density, power, J, derivatives, true);
+      const double a = domain.area[f];
+      face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
+      if (!derivatives || !ev.finite) return;
+      const Eigen::Matrix2d& dmi = domain.rest_inverse[f];
+      Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
+      for (int j = 0; j < 2; ++j)
+        for (int d = 0; d < 2; ++d)
+          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * j + d) = dmi(j, r);
+      const Eigen::Vector4d g4 = a * B.transpose() * ev.gradient;
+      const Eigen::Matrix4d h4 = a * B.transpose() * ev.hessian * B;
+      const Face& el = faces[f];
+      face_g[f].noalias() = el.M.transpose() * g4;
+      face_h[f].noalias() = el.M.transpose() * h4 * el.M;
+    });
+    double energy = 0;
+    for (int f = 0; f < nf; ++f) {
+      if (!std::isfinite(face_value[f])) return std::numeric_limits<double>::infinity();
+      energy += face_value[f];
+    }
+    if (!derivatives) return energy;
+    g->setZero(n());
+    if (Hv) Hv->setZero(n());
+    double* vals = H.valuePtr();
+    std::fill(vals, vals + H.nonZeros(), 0.0);
+    for (int f = 0; f < nf; ++f) {
+      const Face& el = faces[f];
+      const size_t k = el.ys.size();
+      for (size_t i = 0; i < k; ++i)
+        if (state[el.ys[i]] == 0) (*g)[el.ys[i]] += face_g[f][i];
+      for (size_t j = 0; j < k; ++j) {
+        const bool free_j = state[el.ys[j]] == 0;
+        for (size_t i = 0; i < k; ++i) {
+          if (state[el.ys[i]] != 0) continue;
+          if (free_j)
+            vals[el.offsets[j * k + i]] += face_h[f](i, j);
+          else if (Hv)
+            (*Hv)[el.ys[i]] += face_h[f](i, j) * (*v)[el.ys[j]];
+        }
+      }
+    }
+    for (int i = 0; i < n(); ++i)
+      if (state[i] != 0) vals[diag_offset[i]] = 1;
+    return energy;
+  }
+
+  double penalty_value(const Eigen::VectorXd& yy) const {
+    double e = 0;
+    for (const auto& [j, t] : penalty) e += penalty_weight * (yy[j] - t) * (yy[j] - t);
+    return e;
+  }
+  // Adds the penalty's gradient and Hessian (after evaluate() with derivatives).
+  void add_penalty(const Eigen::VectorXd& yy, Eigen::VectorXd* g) {
+    for (const auto& [j, t] : penalty) {
+      if (state[j] != 0) continue;
+      (*g)[j] += 2 * penalty_weight * (yy[j] - t);
+      H.valuePtr()[diag_offset[j]] += 2 * penalty_weight;
+    }
+  }
+
+  // Solves H·dy = rhs with a small diagonal shift on the free rows (retried larger on failure).
+  bool solve_many(const Eigen::MatrixXd& rhs, Eigen::MatrixXd* out) {
+    double mean_diag = 0;
+    int n_free_rows = 0;
+    for (int i = 0; i < n(); ++i)
+      if (state[i] == 0) {
+        mean_diag += H.valuePtr()[diag_offset[i]];
+        ++n_free_rows;
+      }
+    mean_diag = n_free_rows > 0 ? mean_diag / n_free_rows : 1;
+    if (!(mean_diag > 0)) mean_diag = 1;
+    double shift = kPinRegularization * mean_diag;
+    for (int attempt = 0; attempt < 6; ++attempt, shift *= 100) {
+      Eigen::SparseMatrix<double> A = H;
+      for (int i = 0; i < n(); ++i)
+        if (state[i] == 0) A.valuePtr()[diag_offset[i]] += shift;
+      if (!solver.factorize(A).is_ok()) continue;
+      *out = solver.solve(rhs);
+      if (out->allFinite()) return true;
+    }
+    return false;
+  }
+  bool solve(const Eigen::VectorXd& rhs, Eigen::VectorXd* dy) {
+    Eigen::MatrixXd out;
+    if (!solve_many(rhs, &out)) return false;
+    *dy = out.col(0);
+    return true;
+  }
+
+  double max_step(const Eigen::VectorXd& xx, const Eigen::VectorXd& dx) const {
+    double t = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < domain.n_faces(); ++f) {
+      const Eigen::Matrix2d X = edge_matrix(xx, f);
+      if (!(X.determinant() > 0)) continue;
+      t = std::min(t, flip_root(X, edge_matrix(dx, f)));
+    }
+    return t;
+  }
+};
+
+PinnedLayout::PinnedLayout() : impl_(std::make_unique<Impl>()) {}
+PinnedLayout::~PinnedLayout() = default;
+PinnedLayout::PinnedLayout(PinnedLayout&&) noexcept = default;
+PinnedLayout& PinnedLayout::operator=(PinnedLayout&&) noexcept = default;
+
+const ConstrainedReduction& PinnedLayout::reduction() const { return impl_->ext; }
+int PinnedLayout::n_free() const { return impl_->n(); }
+const Eigen::VectorXd& PinnedLayout::y() const { return impl_->y; }
+bool PinnedLayout::is_pinned(int j) const { return impl_->state[j] == 1; }
+int PinnedLayout::n_flipped() const { return count_flipped(impl_->domain, impl_->x); }
+
+Eigen::VectorXd PinnedLayout::x() const {
+  Eigen::VectorXd out(impl_->ext_to_int.size());
+  for (size_t e = 0; e < impl_->ext_to_int.size(); ++e) out[e] = impl_->x[impl_->ext_to_int[e]];
+  return out;
+}
+
+core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& copies,
+                                const Eigen::VectorXd& x0, const PinnedLayoutOptions& options) {
+  Impl& m = *impl_;
+  const int nf = mesh.n_faces();
+  const int n = copies.n_copies();
+  const int n_seams = static_cast<int>(copies.seams.size());
+  if (static_cast<int>(copies.corner_copy.size()) != 3 * nf || x0.size() < 2 * n ||
+      !(options.rest_scale > 0) ||
+      (!options.prefer_free.empty() && static_cast<int>(options.prefer_free.size()) != n) ||
+      (!options.gauge_copies.empty() &&
+       static_cast<int>(options.gauge_copies.size()) != copies.n_components))
+    return core::Status::invalid_input("PinnedLayout: sizes do not match");
+  // Slots of two scalar variables: [one | preferred copies | translations | other copies]. The
+  // eliminator pivots on the highest-index unit coefficient: other copies first, then
+  // translations, and preferred copies only when nothing else is left in a row.
+  std::vector<int> copy_slot(n), seam_slot(n_seams);
+  int slot = 1;
+  for (int k = 0; k < n; ++k)
+    if (!options.prefer_free.empty() && options.prefer_free[k]) copy_slot[k] = slot++;
+  for (int s = 0; s < n_seams; ++s) seam_slot[s] = slot++;
+  for (int k = 0; k < n; ++k)
+    if (options.prefer_free.empty() || !options.prefer_free[k]) copy_slot[k] = slot++;
+  const int n_vars = 2 * slot;
+  m.ext_to_int.resize(2 * n + 2 * n_seams);
+  for (int k = 0; k < n; ++k)
+    for (int d = 0; d < 2; ++d) m.ext_to_int[2 * k + d] = 2 * copy_slot[k] + d;
+  for (int s = 0; s < n_seams; ++s)
+    for (int d = 0; d < 2; ++d) m.ext_to_int[2 * n + 2 * s + d] = 2 * seam_slot[s] + d;
+
+  m.domain = LayoutDomain();
+  m.domain.n_copies = slot;
+  m.domain.face_copies.resize(nf);
+  m.domain.rest_inverse.resize(nf);
+  m.domain.area.resize(nf);
+  for (int f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) m.domain.face_copies[f][k] = copy_slot[copies.corner_copy[3 * f + k]];
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                          p2 = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d e1 = (p1 - p0) * options.rest_scale, e2 = (p2 - p0) * options.rest_scale;
+    const double l1 = e1.norm();
+    Eigen::Matrix2d dm;
+    dm << l1, e1.dot(e2) / l1, 0, e1.cross(e2).norm() / l1;
+    m.domain.rest_inverse[f] = dm.inverse();
+    m.domain.area[f] = 0.5 * e1.cross(e2).norm();
+  }
+  switch (options.energy) {
+    case Energy::kArap:
+      m.density = Density::kArap;
+      break;
+    case Energy::kLinfArap:
+      m.density = Density::kPowerArap;
+      m.power = kPinLinfArapPower;
+      break;
+    case Energy::kConformal:
+      m.density = Density::kMips;
+      break;
+    default:
+      m.density = Density::kSymmetricDirichlet;
+  }
+
+  std::vector<char> never_pivot(n_vars, 0);
+  never_pivot[0] = never_pivot[1] = 1;
+  std::vector<char> gauge_set(copies.n_components, 0);
+  auto fix_copy = [&](int k) {
+    never_pivot[2 * copy_slot[k]] = never_pivot[2 * copy_slot[k] + 1] = 1;
+    gauge_set[copies.copy_component[k]] = 1;
+  };
+  for (int comp = 0; comp < copies.n_components; ++comp) {
+    const int g = options.gauge_copies.empty() ? -1 : options.gauge_copies[comp];
+    if (g >= 0 && g < n && copies.copy_component[g] == comp) fix_copy(g);
+  }
+  for (int k = 0; k < n; ++k)
+    if (copies.copy_component[k] >= 0 && !gauge_set[copies.copy_component[k]]) fix_copy(k);
+  ConstraintEliminator elim(n_vars, never_pivot);
+  for (int si = 0; si < n_seams; ++si) {
+    const CopySeam& s = copies.seams[si];
+    for (const auto& [a, b] : {std::pair{s.a0, s.b0}, std::pair{s.a1, s.b1}})
+      for (int d = 0; d < 2; ++d) {
+        std::map<int, double> acc;
+        acc[2 * copy_slot[b] + d] += 1;
+        for (int j = 0; j < 2; ++j)
+          if (const double r = rotation_entry(s.matching, d, j); r != 0)
+            acc[2 * copy_slot[a] + j] -= r;
+        acc[2 * seam_slot[si] + d] -= 1;
+        elim.add_row(compress(acc));
+      }
+  }
+  Eigen::VectorXd xi = Eigen::VectorXd::Zero(n_vars);
+  xi[0] = 1;
+  for (int k = 0; k < n; ++k) xi.segment<2>(2 * copy_slot[k]) = x0.segment<2>(2 * k);
+  for (int si = 0; si < n_seams; ++si) {
+    const CopySeam& s = copies.seams[si];
+    xi.segment<2>(2 * seam_slot[si]) =
+        xi.segment<2>(2 * copy_slot[s.b0]) -
+        rotate_quarter(xi.segment<2>(2 * copy_slot[s.a0]), s.matching);
+  }
+  m.red = elim.reduction(xi);
+  m.y = m.red.restrict(xi);
+  m.x = m.red.expand(m.y);
+  m.state.assign(m.n(), 0);
+  if (const int flips = count_flipped(m.domain, m.x); flips > 0)
+    return core::Status::invalid_input("PinnedLayout: " + std::to_string(flips) +
+                                       " flipped faces at the start");
+  // External reduction.
+  {
+    const int n_ext = 2 * n + 2 * n_seams;
+    std::vector<int> ext_of(n_vars, -1);
+    for (int e = 0; e < n_ext; ++e) ext_of[m.ext_to_int[e]] = e;
+    std::vector<Eigen::Triplet<double>> trip;
+    m.ext.c.resize(n_ext);
+    for (int e = 0; e < n_ext; ++e) {
+      m.ext.c[e] = m.red.c[m.ext_to_int[e]];
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m.red.P, m.ext_to_int[e]);
+           it; ++it)
+        trip.emplace_back(e, static_cast<int>(it.col()), it.value());
+    }
+    m.ext.P.resize(n_ext, m.n());
+    m.ext.P.setFromTriplets(trip.begin(), trip.end());
+    m.ext.free_vars.clear();
+    for (int v : m.red.free_vars) m.ext.free_vars.push_back(ext_of[v]);
+  }
+  // Face elements over the edge-vector coordinates (shared translation parts cancel).
+  m.faces.assign(nf, {});
+  m.for_faces([&](int f) {
+    const auto& fc = m.domain.face_copies[f];
+    std::array<std::vector<std::pair<int, double>>, 4> rows;
+    for (int j = 0; j < 2; ++j)
+      for (int d = 0; d < 2; ++d) {
+        auto& e = rows[2 * j + d];
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m.red.P, 2 * fc[j + 1] + d);
+             it; ++it)
+          e.push_back({static_cast<int>(it.col()), it.value()});
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m.red.P, 2 * fc[0] + d); it;
+             ++it)
+          e.push_back({static_cast<int>(it.col()), -it.value()});
+        std::sort(e.begin(), e.end());
+        std::vector<std::pair<int, double>> merged;
+        for (const auto& [v, a] : e) {
+          if (!merged.empty() && merged.back().first == v)
+            merged.back().second += a;
+          else
+            merged.push_back({v, a});
+        }
+        std::erase_if(merged, [](const auto& p) { return std::abs(p.second) <= kPinCancelled; });
+        e = std::move(merged);
+      }
+    Impl::Face& el = m.faces[f];
+    for (const auto& row : rows)
+      for (const auto& [v, a] : row) el.ys.push_back(v);
+    std::sort(el.ys.begin(), el.ys.end());
+    el.ys.erase(std::unique(el.ys.begin(), el.ys.end()), el.ys.end());
+    el.M = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, el.ys.size());
+    for (int i = 0; i < 4; ++i)
+      for (const auto& [v, a] : rows[i])
+        el.M(i, std::lower_bound(el.ys.begin(), el.ys.end(), v) - el.ys.begin()) += a;
+  });
+  // Hessian pattern, analysed once.
+  std::vector<Eigen::Triplet<double>> trip;
+  for (int i = 0; i < m.n(); ++i) trip.emplace_back(i, i, 0.0);
+  for (const Impl::Face& el : m.faces)
+    for (int a : el.ys)
+      for (int b : el.ys) trip.emplace_back(a, b, 0.0);
+  m.H.resize(m.n(), m.n());
+  m.H.setFromTriplets(trip.begin(), trip.end());
+  m.H.makeCompressed();
+  auto locate = [&](int row, int col) {
+    const int* begin = m.H.innerIndexPtr() + m.H.outerIndexPtr()[col];
+    const int* end = m.H.innerIndexPtr() + m.H.outerIndexPtr()[col + 1];
+    return static_cast<int>(std::lower_bound(begin, end, row) - m.H.innerIndexPtr());
+  };
+  m.diag_offset.resize(m.n());
+  for (int i = 0; i < m.n(); ++i) m.diag_offset[i] = locate(i, i);
+  for (Impl::Face& el : m.faces) {
+    const size_t k = el.ys.size();
+    el.offsets.resize(k * k);
+    for (size_t j = 0; j < k; ++j)
+      for (size_t i = 0; i < k; ++i) el.offsets[j * k + i] = locate(el.ys[i], el.ys[j]);
+  }
+  if (m.n() > 0) {
+    std::fill(m.H.valuePtr(), m.H.valuePtr() + m.H.nonZeros(), 0.0);
+    for (int i = 0; i < m.n(); ++i) m.H.valuePtr()[m.diag_offset[i]] = 1;
+    if (const core::Status st = m.solver.analyze(m.H); !st.is_ok())
+      return core::Status::numerical_failure("PinnedLayout: analysis failed: " + st.message());
+  }
+  return core::Status::ok();
+}
+
+bool PinnedLayout::determined_faces_valid(
+    const std::vector<std::pair<int, double>>& targets) const {
+  const Impl& m = *impl_;
+  std::vector<char> target(m.n(), 0);
+  Eigen::VectorXd y_target = m.y;
+  for (const auto& [j, value] : targets) {
+    if (j < 0 || j >= m.n()) return false;
+    target[j] = 1;
+    y_target[j] = value;
+  }
+  const Eigen::VectorXd x_target = m.red.expand(y_target);
+  for (int f = 0; f < m.domain.n_faces(); ++f) {
+    bool determined = true, moved = false;
+    for (const int j : m.faces[f].ys) {
+      determined = determined && (m.state[j] == 1 || target[j]);
+      moved = moved || target[j];
+    }
+    if (!determined || !moved) continue;
+    const auto& fc = m.domain.face_copies[f];
+    if (core::orient2d(x_target.segment<2>(2 * fc[0]), x_target.segment<2>(2 * fc[1]),
+                       x_target.segment<2>(2 * fc[2])) <= 0)
+      return false;
+  }
+  return true;
+}
+
+int PinnedLayout::minimize(int max_iterations, double relative_tolerance, core::Status* status) {
+  Impl& m = *impl_;
+  *status = core::Status::ok();
+  if (m.n() == 0) return 0;
+  Eigen::VectorXd g, dy;
+  double energy = m.evaluate(m.x, true, &g) + m.penalty_value(m.y);
+  m.add_penalty(m.y, &g);
+  int iterations = 0;
+  for (int it = 0; it < max_iterations; ++it) {
+    if (!m.solve(-g, &dy)) {
+      *status = core::Status::numerical_failure("PinnedLayout: Newton system failed");
+      break;
+    }
+    for (int i = 0; i < m.n(); ++i)
+      if (m.state[i] != 0) dy[i] = 0;
+    const double decrement = -g.dot(dy);
+    if (decrement <= relative_tolerance * std::abs(energy)) break;
+    const Eigen::VectorXd dx = m.red.P * dy;
+    double alpha = std::min(1.0, kPinStepFraction * m.max_step(m.x, dx));
+    Eigen::VectorXd x_trial;
+    int bt = 0;
+    for (; bt < kPinBacktracks; ++bt, alpha *= 0.5) {
+      x_trial = m.x + alpha * dx;
+      const double e = m.evaluate(x_trial, false, nullptr) + m.penalty_value(m.y + alpha * dy);
+      if (e <= energy - kPinArmijo * alpha * decrement) break;
+    }
+    if (bt == kPinBacktracks) break;
+    const Eigen::VectorXd y_trial = m.y + alpha * dy;
+    const Eigen::VectorXd x_new = m.red.expand(y_trial);
+    if (count_flipped(m.domain, x_new) > 0) break;  // round-off at the barrier: stop here
+    m.y = y_trial;
+    m.x = x_new;
+    ++iterations;
+    const double previous = energy;
+    energy = m.evaluate(m.x, true, &g) + m.penalty_value(m.y);
+    m.add_penalty(m.y, &g);
+    if (previous - energy <= 1e-3 * relative_tolerance * std::abs(previous)) break;
+  }
+  return iterations;
+}
+
+PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
+                            const PinSettings& settings, int relax_iterations,
+                            double relax_tolerance) {
+  Impl& m = *impl_;
+  PinReport rep;
+  const size_t nt = targets.size();
+  rep.pinned.assign(nt, 0);
+  rep.blocking.assign(nt, 0);
+  std::vector<char> active(nt, 0);
+  for (size_t i = 0; i < nt; ++i) {
+    const int j = targets[i].first;
+    if (j < 0 || j >= m.n() || m.state[j] != 0) continue;  // out of range or already taken
+    active[i] = 1;
+    m.state[j] = 2;
+  }
+  // Faces that the pinned and prescribed variables alone determine cannot be helped by the free
+  // ones: a target that leaves one of them flipped or degenerate (e.g. a cone on the line of two
+  // pinned cones of its triangle) is dropped before any step.
+  {
+    Eigen::VectorXd y_target = m.y;
+    for (size_t i = 0; i < nt; ++i)
+      if (active[i]) y_target[targets[i].first] = targets[i].second;
+    const Eigen::VectorXd x_target = m.red.expand(y_target);
+    for (int f = 0; f < m.domain.n_faces(); ++f) {
+      const Impl::Face& el = m.faces[f];
+      bool determined = true, moved = false;
+      for (const int j : el.ys) {
+        determined = determined && m.state[j] != 0;
+        moved = moved || m.state[j] == 2;
+      }
+      if (!determined || !moved) continue;
+      const auto& fc = m.domain.face_copies[f];
+      if (core::orient2d(x_target.segment<2>(2 * fc[0]), x_target.segment<2>(2 * fc[1]),
+                         x_target.segment<2>(2 * fc[2])) > 0)
+        continue;
+      for (size_t i = 0; i < nt; ++i)
+        if (active[i] && std::binary_search(el.ys.begin(), el.ys.end(), targets[i].first)) {
+          active[i] = 0;
+          rep.blocking[i] = 1;
+          m.state[targets[i].first] = 0;
+        }
+    }
+  }
+  // Targets farther than a full flip-free step (cones pulled apart, a translation that shears a
+  // handle) first move by a penalty homotopy: Newton on energy + w·Σ (y_j − target)² with w
+  // growing, where the barrier bends the layout out of the way instead of the linear response
+  // crushing it. A target that the barrier holds back (its residual stops shrinking) blocks.
+  if (settings.penalty_stages > 0) {
+    Eigen::VectorXd g0, Hv0, v0 = Eigen::VectorXd::Zero(m.n()), dy0;
+    double v_max = 0;
+    for (size_t i = 0; i < nt; ++i)
+      if (active[i]) {
+        v0[targets[i].first] = targets[i].second - m.y[targets[i].first];
+        v_max = std::max(v_max, std::abs(v0[targets[i].first]));
+      }
+    bool reaches = v_max == 0;
+    if (!reaches) {
+      m.evaluate(m.x, true, &g0, &v0, &Hv0);
+      Eigen::VectorXd rhs = -Hv0;
+      for (int i = 0; i < m.n(); ++i)
+        if (m.state[i] != 0) rhs[i] = v0[i];
+      if (m.solve(rhs, &dy0)) {
+        for (int i = 0; i < m.n(); ++i)
+          if (m.state[i] != 0) dy0[i] = v0[i];
+        reaches = kPinStepFraction * m.max_step(m.x, m.red.P * dy0) >= 1;
+      }
+    }
+    if (!reaches) {
+      double mean_area = 0, mean_edge_sq = 0;
+      for (int f = 0; f < m.domain.n_faces(); ++f) {
+        mean_area += m.domain.area[f];
+        const Eigen::Matrix2d dm = m.domain.rest_inverse[f].inverse();
+        mean_edge_sq += dm.col(0).squaredNorm();
+      }
+      // One triangle's stiffness: energy per squared displacement of a vertex.
+      const double unit = mean_area / std::max(1e-300, mean_edge_sq);
+      std::vector<double> initial(nt, 0), last(nt, 0);
+      m.penalty.clear();
+      for (size_t i = 0; i < nt; ++i)
+        if (active[i]) {
+          m.state[targets[i].first] = 0;
+          m.penalty.push_back(targets[i]);
+          initial[i] = last[i] = std::abs(targets[i].second - m.y[targets[i].first]);
+        }
+      double w = settings.first_penalty;
+      for (int stage = 0; stage < settings.penalty_stages; ++stage, w *= settings.penalty_growth) {
+        m.penalty_weight = w * unit;
+        core::Status st;
+        rep.iterations += minimize(settings.stage_iterations, kPinStageTolerance, &st);
+        if (!st.is_ok()) {
+          rep.status = st;
+          break;
+        }
+        double r_max = 0;
+        bool shrinking = false;
+        for (size_t i = 0; i < nt; ++i)
+          if (active[i]) {
+            const double r = std::abs(targets[i].second - m.y[targets[i].first]);
+            r_max = std::max(r_max, r);
+            shrinking = shrinking || r < kPinShrink * last[i];
+            last[i] = r;
+          }
+        if (r_max < settings.snap_residual || (stage >= 2 && !shrinking)) break;
+      }
+      m.penalty.clear();
+      m.penalty_weight = 0;
+      for (size_t i = 0; i < nt; ++i) {
+        if (!active[i]) continue;
+        if (last[i] > settings.snap_residual && last[i] > kPinHeldBack * initial[i]) {
+          active[i] = 0;  // held back by the barrier
+          rep.blocking[i] = 1;
+        } else {
+          m.state[targets[i].first] = 2;
+        }
+      }
+    }
+  }
+  Eigen::VectorXd g, Hv, dy, v = Eigen::VectorXd::Zero(m.n());
+  int stalled = 0, approach = 0;
+  for (int step = 0; step < settings.max_steps; ++step) {
+    v.setZero();
+    bool any = false;
+    for (size_t i = 0; i < nt; ++i)
+      if (active[i]) {
+        v[targets[i].first] = targets[i].second - m.y[targets[i].first];
+        any = any || v[targets[i].first] != 0;
+      }
+    if (!any) break;
+    // One factorization, two directions: the response of the free variables to the prescribed
+    // displacement (H_ff·dp_f = −H_fp·v, dp = v on the targets), and the energy Newton step
+    // (H_ff·de_f = −g_f). The first is taken as far as it stays flip-free (to the targets when
+    // the whole of it is), the second then relaxes the layout away from the barrier; mixed in one
+    // direction, the energy part would keep the step short of the targets near a barrier.
+    const double energy = m.evaluate(m.x, true, &g, &v, &Hv);
+    Eigen::MatrixXd rhs(m.n(), 2);
+    rhs.col(0) = -Hv;
+    rhs.col(1) = -g;
+    for (int i = 0; i < m.n(); ++i)
+      if (m.state[i] != 0) {
+        rhs(i, 0) = v[i];
+        rhs(i, 1) = 0;
+      }
+    Eigen::MatrixXd dirs;
+    if (!m.solve_many(rhs, &dirs)) {
+      rep.status = core::Status::numerical_failure("PinnedLayout: Newton system failed");
+      break;
+    }
+    for (int i = 0; i < m.n(); ++i)
+      if (m.state[i] != 0) {
+        dirs(i, 0) = v[i];
+        dirs(i, 1) = 0;
+      }
+    dy = dirs.col(0);
+    const Eigen::VectorXd dx = m.red.P * dy;
+    const double t_max = m.max_step(m.x, dx);
+    double alpha = t_max * kPinStepFraction >= 1 ? 1.0 : kPinStepFraction * t_max;
+    bool accepted = false;
+    for (int h = 0; h < kPinExactHalvings; ++h, alpha *= 0.5) {
+      Eigen::VectorXd y_new = m.y + alpha * dy;
+      if (alpha == 1.0)
+        for (size_t i = 0; i < nt; ++i)
+          if (active[i]) y_new[targets[i].first] = targets[i].second;
+      const Eigen::VectorXd x_new = m.red.expand(y_new);
+      if (count_flipped(m.domain, x_new) > 0) continue;
+      m.y = std::move(y_new);
+      m.x = x_new;
+      accepted = true;
+      ++rep.iterations;
+      break;
+    }
+    if (accepted && alpha < 1.0) {
+      // Energy step from the new point (the old Newton direction, if still a descent one).
+      const Eigen::VectorXd de = dirs.col(1);
+      const Eigen::VectorXd dxe = m.red.P * de;
+      const double e0 = m.evaluate(m.x, false, nullptr);
+      double beta = std::min(1.0, kPinStepFraction * m.max_step(m.x, dxe));
+      const double decrease = std::max(0.0, energy - e0);
+      (void)decrease;
+      for (int bt = 0; bt < kPinBacktracks / 4; ++bt, beta *= 0.5) {
+        const Eigen::VectorXd y_new = m.y + beta * de;
+        const Eigen::VectorXd x_new = m.red.expand(y_new);
+        if (!(m.evaluate(x_new, false, nullptr) < e0)) continue;
+        if (count_flipped(m.domain, x_new) > 0) continue;
+        m.y = y_new;
+        m.x = x_new;
+        break;
+      }
+    }
+    if (!accepted) alpha = 0;
+    if (alpha == 1.0) continue;  // targets reached (the next step sees v = 0)
+    // Stalled (tiny steps), or approaching without ever reaching: when the target squeezes a
+    // region to zero area (two cones that meet through a seam), the limiting triangles shrink
+    // as fast as the remaining displacement and every step stops at the same fraction.
+    stalled = alpha < settings.stall_fraction ? stalled + 1 : 0;
+    ++approach;
+    if (stalled < kStalledSteps && approach < settings.approach_steps) continue;
+    approach = 0;
+    // Drop the targets whose faces limit the step: they collide with something.
+    stalled = 0;
+    // Limiting faces (they would flip within the full step) and the faces around them: the
+    // region being squeezed. The targets that enter its faces are the culprits.
+    std::vector<char> limiting(m.n(), 0), squeezed_slot(m.domain.n_copies, 0);
+    for (int f = 0; f < m.domain.n_faces(); ++f) {
+      const Eigen::Matrix2d X = m.edge_matrix(m.x, f);
+      if (flip_root(X, m.edge_matrix(dx, f)) > 1 / kPinStepFraction) continue;
+      for (const int c : m.domain.face_copies[f]) squeezed_slot[c] = 1;
+    }
+    for (int f = 0; f < m.domain.n_faces(); ++f) {
+      const auto& fc = m.domain.face_copies[f];
+      if (squeezed_slot[fc[0]] || squeezed_slot[fc[1]] || squeezed_slot[fc[2]])
+        for (int j : m.faces[f].ys) limiting[j] = 1;
+    }
+    bool dropped = false;
+    for (size_t i = 0; i < nt; ++i)
+      if (active[i] && limiting[targets[i].first]) {
+        active[i] = 0;
+        rep.blocking[i] = 1;
+        m.state[targets[i].first] = 0;
+        dropped = true;
+      }
+    if (!dropped) {
+      for (size_t i = 0; i < nt; ++i)
+        if (active[i]) {
+          active[i] = 0;
+          rep.blocking[i] = 1;
+          m.state[targets[i].first] = 0;
+        }
+    }
+    if (std::none_of(active.begin(), active.end(), [](char a) { return a != 0; })) break;
+  }
+  for (size_t i = 0; i < nt; ++i) {
+    if (!active[i]) continue;
+    const int j = targets[i].first;
+    if (m.y[j] == targets[i].second) {
+      m.state[j] = 1;
+      rep.pinned[i] = 1;
+    } else {
+      m.state[j] = 0;
+    }
+  }
+  if (rep.status.is_ok() && relax_iterations > 0) {
+    core::Status st;
+    rep.iterations += minimize(relax_iterations, relax_tolerance, &st);
+    rep.status = st;
+  }
+  return rep;
 }
 
 }  // namespace quadify::param

@@ -5,23 +5,24 @@
 // 2. Unknowns. Vertex copies are the corners merged across edges where both sides agree
 //    (param::build_copy_layout). The integer candidates are both coordinates of every cone copy
 //    and both components of every seam translation t = x_b0 − R^r x_a0. The translation gauge
-//    fixes one copy per component (a cone copy when there is one) at the origin. Candidates are
-//    turned into affine rows "candidate = integer" and fed to libparam's exact incremental
-//    eliminator together with the homogeneous seam rows: a row dependent on earlier ones is an
-//    integer combination of integer rows (unit pivots, 0/±1 coefficients) and is dropped.
-// 3. Rounding. Cone copies first (a cone fixed only through the translations around it may sit
-//    on a half-integer, see Rounder::run), then translations, each in batches by rounding error
-//    (below 1/8, 2/8, …; the last batch takes the rest; smallest error first). A cone goes to the
-//    nearest corner of its grid cell not yet taken by another cone vertex of its chart. After
-//    each batch the layout is moved flip-free into the new constraint space and re-optimized
-//    (param::solve_constrained_layout: penalty homotopy + projection + barrier Newton). A batch
-//    that leaves flips (a triangle degenerated, e.g. two cones on one grid point) or makes a
-//    fully determined unknown fractional (wrong parity) is reverted and split in halves; a single
-//    failing unknown is rounded to the other neighbouring integer. Parity is checked before any
-//    solve by the elimination alone (see Rounder::repair_parity); a run that dead-ends because
-//    both neighbours of an unknown imply a fractional cone restarts with those cones first.
-//    If that fails too, or after 16 failed re-optimizations, the rounding restarts at nearby
-//    scales (×1 ± 2%, ±4%), then at scales grown by ×1.25 (max_scale_retries times).
+//    fixes one copy per component (a cone copy when there is one) at the origin. The seam rows are
+//    eliminated once (param::PinnedLayout) with the cone copies kept free and translations
+//    pivoted before them: the loop around a cone, (I − R)·x_cone = Σ R·t, is solved for a
+//    translation (unit coefficient), so every candidate is an integer combination of free
+//    integer columns (checked; no parity conditions remain) and rounding pins free variables.
+//    The Hessian pattern over the free variables never changes: element maps and the symbolic
+//    factorization are built once per scale, every batch costs numeric factorizations only.
+// 3. Rounding. Cones first, then the remaining free integer columns (translations around
+//    handles). Cones within 1.5 units of another cone of their chart (same-sign clusters left by
+//    the parametrization) go first, jointly: pairs (cone, free grid point) by distance, so that
+//    they take distinct grid points, moved by a penalty homotopy while the rest of the map is
+//    free. The other cones follow in batches by rounding error (below 1/8, 2/8, …). A batch is
+//    pinned by Newton steps that prescribe the remaining displacement of its targets (the free
+//    variables follow by the Hessian's response, as far as the step stays flip-free, plus an
+//    energy step); targets whose faces limit every step (a collision, a squeezed region) are
+//    dropped and try other free grid points (or the other neighbouring integer) one at a time.
+//    A run that still dead-ends restarts at nearby scales (×1 ± 2%, ±4%), then at scales grown
+//    by ×1.25 (max_scale_retries times). options.time_budget_seconds bounds the whole.
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
@@ -44,6 +45,7 @@
 #include <numeric>
 #include <optional>
 #include <limits>
+#include <cstdio>
 #include <tuple>
 
 namespace quadify::quantize {
@@ -61,21 +63,17 @@ constexpr int kDyadicBits = 30;
 // with matching 2 can leave a pivot of 2, so P and c are dyadic with small denominators. Up to
 // 2^-kMaxDenominatorBits, the products with y (multiples of 2^-kDyadicBits) stay exact.
 constexpr int kMaxDenominatorBits = 8;
-// An implied (fully determined) candidate farther than this from an integer is fractional; exact
-// implied values are multiples of 1/4 (the determinant of I − R^r is 2 or 4), so 1/8 separates
-// them from round-off.
-constexpr double kParityTolerance = 0.125;
-// Failed re-optimizations (each a full penalty homotopy) tolerated at one scale before the scale
-// is refined: bounds the time spent on cones too close to be separated at this density.
-constexpr int kMaxFailedSolvesPerScale = 16;
+// Cones closer than this (max norm, quad units) to another cone of their chart compete for grid
+// points: they are rounded first, jointly.
+constexpr double kClusterRadius = 1.5;
+// Rings of grid cells around a cone's own cell searched for a free grid point.
+constexpr int kGridRing = 1;
+// Penalty stages (param::PinSettings) for clustered cones, which move up to a unit or two.
+constexpr int kFarPenaltyStages = 8;
+// Other grid points tried, one at a time, for a cone whose batch could not move it.
+constexpr size_t kConeAlternatives = 4;
 // Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
 constexpr double kConePairMeshEdges = 8;
-// Restarts at one scale with the cones that a run found doomed by parity rounded first.
-constexpr int kMaxPriorityRestarts = 4;
-// Sweeps over a batch of the parity repair (each tries every item's other neighbour once).
-constexpr int kParityRepairPasses = 3;
-// Newton iterations per stage of the long penalty homotopy used for a single failing unknown.
-constexpr int kSingleHomotopyIterations = 40;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
 constexpr double kFinalTolerance = 1e-7;
@@ -143,308 +141,330 @@ int count_flipped(const param::CopyLayout& cl, const Eigen::VectorXd& x, int nf)
   return n;
 }
 
-// The state of one rounding run at a fixed scale.
+// One rounding run at a fixed scale over a param::PinnedLayout (see the method note above).
 class Rounder {
  public:
-  // One integer candidate set to rhs.
-  struct Item {
-    int candidate;
-    double rhs;
-    double value;  // before rounding
-  };
+  enum class Outcome { kDone, kStuck, kOutOfTime, kFailed };
 
   Rounder(const core::TriMesh& mesh, const param::CopyLayout& cl,
           const std::vector<Candidate>& candidates, const std::vector<char>& is_cone_copy,
-          const param::ConstrainedLayoutOptions& layout_options, QuantizeStats* stats)
+          const QuantizeOptions& options, QuantizeStats* stats, Clock::time_point deadline,
+          std::string scale_label)
       : mesh_(mesh),
         cl_(cl),
         cand_(candidates),
         is_cone_copy_(is_cone_copy),
-        lopt_(layout_options),
+        opt_(options),
         stats_(stats),
-        priority_(candidates.size(), 0) {}
+        deadline_(deadline),
+        label_(std::move(scale_label)) {}
 
-  // Rounds every candidate starting from x (satisfying the seam rows); false when stuck.
-  bool run(Eigen::VectorXd x, double threshold_step,
-           const std::function<void(const std::string&, int, int)>& progress) {
-    x_ = std::move(x);
-    decided_.assign(cand_.size(), 0);
-    rows_.clear();
-    const int n_steps = std::max(1, static_cast<int>(std::ceil(0.5 / threshold_step - 1e-9)));
-    // Cones first: a cone's position is fixed by the translations around it through (I − R^r),
-    // whose determinant is 2 or 4, so integer translations alone may put it on a half-integer.
-    // Fixing the cones first makes the translations integer combinations of the cone integers.
-    for (const bool cone_phase : {true, false})
-      for (int step = 0; step < n_steps; ++step) {
-        if (progress) progress("quantize", step + (cone_phase ? 0 : n_steps), 2 * n_steps);
-        const bool last = step + 1 == n_steps;
-        const double eps = threshold_step * (step + 1);
-        std::vector<Item> items = cone_phase ? cone_batch(eps, last) : translation_batch(eps, last);
-        if (items.empty()) continue;
-        if (!process(items, last && !cone_phase)) return false;
+  Outcome run(const Eigen::VectorXd& x, const param::PinnedLayoutOptions& layout_options) {
+    auto tc = Clock::now();
+    status_ = layout_.init(mesh_, cl_, x, layout_options);
+    stats_->seconds_setup += seconds_since(tc);
+    if (!status_.is_ok()) return Outcome::kFailed;
+    if (!find_integer_columns()) return Outcome::kFailed;
+    tc = Clock::now();
+    stats_->n_iterations += layout_.minimize(opt_.max_newton_iters, kBatchTolerance, &status_);
+    if (!status_.is_ok()) return Outcome::kFailed;
+    Outcome outcome = round_cones();
+    if (outcome == Outcome::kDone) outcome = round_others();
+    stats_->seconds_rounding += seconds_since(tc);
+    if (outcome != Outcome::kDone) return outcome;
+    tc = Clock::now();
+    stats_->n_iterations += layout_.minimize(opt_.max_newton_iters, kFinalTolerance, &status_);
+    stats_->seconds_final += seconds_since(tc);
+    if (!status_.is_ok()) return Outcome::kFailed;
+    for (const int j : int_cols_)
+      if (!layout_.is_pinned(j)) return Outcome::kStuck;
+    return layout_.n_flipped() == 0 ? Outcome::kDone : Outcome::kStuck;
+  }
+
+  const param::PinnedLayout& layout() const { return layout_; }
+  const core::Status& status() const { return status_; }
+  int n_integer_columns() const { return static_cast<int>(int_cols_.size()); }
+  int n_pinned() const { return n_pinned_; }
+  const std::string& stuck_reason() const { return stuck_; }
+
+ private:
+  // A cone copy whose two coordinates are free variables.
+  struct Cone {
+    int copy, col_u, col_v;
+  };
+
+  // Free columns that are integer candidates, and the lattice check: every candidate must be an
+  // integer combination of them plus an integer offset, so that pinning them to integers makes
+  // every candidate an integer (no parity conditions).
+  bool find_integer_columns() {
+    const param::ConstrainedReduction& red = layout_.reduction();
+    std::vector<int> col_of_var(red.P.rows(), -1);
+    for (size_t j = 0; j < red.free_vars.size(); ++j) col_of_var[red.free_vars[j]] = static_cast<int>(j);
+    std::vector<char> is_candidate_var(red.P.rows(), 0);
+    for (const Candidate& c : cand_) is_candidate_var[c.form[0].first] = 1;
+    std::vector<char> is_int_col(red.free_vars.size(), 0);
+    for (size_t j = 0; j < red.free_vars.size(); ++j)
+      is_int_col[j] = is_candidate_var[red.free_vars[j]];
+    for (size_t i = 0; i < cand_.size(); ++i) {
+      const int v = cand_[i].form[0].first;
+      bool integral = red.c[v] == std::round(red.c[v]);
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
+        integral = integral && is_int_col[it.col()] && it.value() == std::round(it.value());
+      if (!integral) {
+        status_ = core::Status::internal(
+            "integer unknown " + std::to_string(i) +
+            " is not an integer combination of the free integer unknowns (non-unit pivot)");
+        return false;
       }
-    // A final solve without new rows converges the layout further.
-    lopt_.relative_tolerance = kFinalTolerance;
-    param::ConstrainedLayoutResult res =
-        param::solve_constrained_layout(mesh_, cl_, x_, rows_, {}, lopt_);
-    stats_->n_iterations += res.iterations;
-    if (!res.status.is_ok() || res.n_flipped > 0) return false;
-    x_ = res.x;
-    reduction_ = std::move(res.reduction);
+    }
+    for (size_t j = 0; j < red.free_vars.size(); ++j)
+      if (is_int_col[j]) int_cols_.push_back(static_cast<int>(j));
+    for (int k = 0; k < cl_.n_copies(); ++k) {
+      if (!is_cone_copy_[k]) continue;
+      const int cu = col_of_var[2 * k], cv = col_of_var[2 * k + 1];
+      if (cu >= 0 && cv >= 0) cones_.push_back({k, cu, cv});
+    }
     return true;
   }
 
-  const Eigen::VectorXd& x() const { return x_; }
-  const std::vector<int>& doomed() const { return doomed_; }
-  void set_priority(const std::vector<char>& priority) { priority_ = priority; }
-
-  // Translations with rounding error below eps (all when last), smallest error first.
-  std::vector<Item> translation_batch(double eps, bool last) const {
-    std::vector<std::pair<double, int>> batch;  // (error, candidate)
-    for (size_t i = 0; i < cand_.size(); ++i) {
-      if (decided_[i] || cand_[i].is_cone) continue;
-      const double v = cand_[i].value(x_);
-      const double err = std::abs(v - std::round(v));
-      if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
-    }
-    std::sort(batch.begin(), batch.end());
-    std::vector<Item> items;
-    for (const auto& [err, i] : batch) {
-      const double v = cand_[i].value(x_);
-      items.push_back({i, std::round(v), v});
-    }
-    return items;
+  void report_progress(const char* what) const {
+    if (opt_.progress) opt_.progress("quantize " + label_ + " " + what, n_pinned_, n_integer_columns());
   }
 
-  // Cone copies whose distance (max norm) to the nearest integer point is below eps (all when
-  // last), nearest first. Each goes to the nearest corner of its grid cell that no other cone
-  // vertex of its component occupies yet (in the cut layout), so that nearby cones do not
-  // collapse onto one grid point.
-  std::vector<Item> cone_batch(double eps, bool last) const {
-    std::map<std::tuple<int, long long, long long>, int> occupied;  // (component, u, v) → vertex
-    std::vector<std::pair<double, int>> batch;  // (error, u candidate of the copy)
-    for (size_t i = 0; i < cand_.size(); ++i) {
-      if (!cand_[i].is_cone || cand_[i].coord != 0) continue;
-      const int k = cand_[i].copy;
-      const double pu = x_[2 * k], pv = x_[2 * k + 1];
-      if (decided_[i] && decided_[i + 1]) {
-        occupied[{cl_.copy_component[k], std::llround(pu), std::llround(pv)}] = cl_.copy_vertex[k];
+  bool out_of_time() const { return Clock::now() > deadline_; }
+
+  // Pins (column, value) targets; returns the per-target pinned flags.
+  std::vector<char> pin(const std::vector<std::pair<int, double>>& targets, bool far = false) {
+    param::PinSettings settings;
+    if (far) settings.penalty_stages = kFarPenaltyStages;
+    const param::PinReport rep =
+        layout_.pin(targets, settings, opt_.max_newton_iters, kBatchTolerance);
+    stats_->n_iterations += rep.iterations;
+    if (!rep.status.is_ok()) status_ = rep.status;
+    for (const char p : rep.pinned) n_pinned_ += p;
+    ++stats_->n_batches;
+    return rep.pinned;
+  }
+
+  Eigen::Vector2d position(const Cone& c) const {
+    return {layout_.y()[c.col_u], layout_.y()[c.col_v]};
+  }
+  using GridKey = std::tuple<int, long long, long long>;  // (component, u, v)
+  GridKey key(const Cone& c, double u, double v) const {
+    return {cl_.copy_component[c.copy], std::llround(u), std::llround(v)};
+  }
+  bool free_point(const Cone& c, double u, double v) const {
+    const auto it = occupied_.find(key(c, u, v));
+    return it == occupied_.end() || it->second == cl_.copy_vertex[c.copy];
+  }
+
+  // Grid points around a cone (its cell's corners and the ring around them) that no other cone
+  // vertex of its chart holds, nearest first; a coordinate already pinned stays.
+  std::vector<Eigen::Vector2d> grid_choices(const Cone& c) const {
+    const Eigen::Vector2d p = position(c);
+    const bool u_pinned = layout_.is_pinned(c.col_u), v_pinned = layout_.is_pinned(c.col_v);
+    std::vector<std::pair<double, Eigen::Vector2d>> pts;
+    for (int du = -kGridRing; du <= 1 + kGridRing; ++du)
+      for (int dv = -kGridRing; dv <= 1 + kGridRing; ++dv) {
+        const Eigen::Vector2d g(u_pinned ? p.x() : std::floor(p.x()) + du,
+                                v_pinned ? p.y() : std::floor(p.y()) + dv);
+        if ((u_pinned && du != 0) || (v_pinned && dv != 0)) continue;
+        if (!free_point(c, g.x(), g.y())) continue;
+        pts.push_back({(g - p).norm(), g});
+      }
+    std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    std::vector<Eigen::Vector2d> out;
+    for (const auto& [d, g] : pts) out.push_back(g);
+    return out;
+  }
+
+  // Cones whose positions are within kClusterRadius of another unpinned cone of their chart:
+  // these compete for grid points and are rounded first, jointly, while everything else can
+  // still move (a cone pulled a whole unit away from its neighbour needs the most room).
+  std::vector<char> clustered(const std::vector<int>& open) const {
+    std::vector<char> in(cones_.size(), 0);
+    std::map<std::tuple<int, long long, long long>, std::vector<int>> buckets;
+    for (const int i : open) {
+      const Eigen::Vector2d p = position(cones_[i]);
+      buckets[{cl_.copy_component[cones_[i].copy], std::llround(std::floor(p.x() / kClusterRadius)),
+               std::llround(std::floor(p.y() / kClusterRadius))}]
+          .push_back(i);
+    }
+    for (const int i : open) {
+      const Eigen::Vector2d p = position(cones_[i]);
+      const int comp = cl_.copy_component[cones_[i].copy];
+      const long long bu = std::llround(std::floor(p.x() / kClusterRadius)),
+                      bv = std::llround(std::floor(p.y() / kClusterRadius));
+      for (long long du = -1; du <= 1 && !in[i]; ++du)
+        for (long long dv = -1; dv <= 1 && !in[i]; ++dv) {
+          const auto it = buckets.find({comp, bu + du, bv + dv});
+          if (it == buckets.end()) continue;
+          for (const int o : it->second)
+            if (o != i && cl_.copy_vertex[cones_[o].copy] != cl_.copy_vertex[cones_[i].copy] &&
+                (position(cones_[o]) - p).lpNorm<Eigen::Infinity>() < kClusterRadius)
+              in[i] = in[o] = 1;
+        }
+    }
+    return in;
+  }
+
+  // Rounds a batch of cones jointly: pairs (cone, free grid point) by increasing distance, each
+  // cone taking the nearest point no earlier cone of the batch took. Cones that the pin could
+  // not move (a collision or a fold in the way) then try their other grid points one by one.
+  Outcome round_cone_batch(const std::vector<int>& batch, bool cluster) {
+    std::vector<std::tuple<double, int, Eigen::Vector2d>> pairs;
+    for (const int i : batch)
+      for (const Eigen::Vector2d& g : grid_choices(cones_[i]))
+        pairs.push_back({(g - position(cones_[i])).norm(), i, g});
+    std::stable_sort(pairs.begin(), pairs.end(),
+                     [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
+    std::map<int, Eigen::Vector2d> pick;
+    std::map<GridKey, int> taken;
+    std::vector<std::pair<int, double>> picked_targets;
+    for (const auto& [d, i, g] : pairs) {
+      if (pick.count(i)) continue;
+      const GridKey k = key(cones_[i], g.x(), g.y());
+      if (const auto it = taken.find(k);
+          it != taken.end() && cl_.copy_vertex[cones_[it->second].copy] != cl_.copy_vertex[cones_[i].copy])
+        continue;
+      if (cluster) {
+        // Cones of one triangle must take a positively oriented lattice triangle.
+        std::vector<std::pair<int, double>> trial = picked_targets;
+        if (!layout_.is_pinned(cones_[i].col_u)) trial.push_back({cones_[i].col_u, g.x()});
+        if (!layout_.is_pinned(cones_[i].col_v)) trial.push_back({cones_[i].col_v, g.y()});
+        if (!layout_.determined_faces_valid(trial)) continue;
+        picked_targets = std::move(trial);
+      }
+      pick[i] = g;
+      taken[k] = i;
+    }
+    std::vector<std::pair<int, double>> targets;
+    std::vector<int> owner;
+    for (const auto& [i, g] : pick) {
+      if (!layout_.is_pinned(cones_[i].col_u)) {
+        targets.push_back({cones_[i].col_u, g.x()});
+        owner.push_back(i);
+      }
+      if (!layout_.is_pinned(cones_[i].col_v)) {
+        targets.push_back({cones_[i].col_v, g.y()});
+        owner.push_back(i);
+      }
+    }
+    if (out_of_time()) return Outcome::kOutOfTime;
+    pin(targets, cluster);
+    if (!status_.is_ok()) return Outcome::kFailed;
+    report_progress("cones");
+    for (const int i : batch) {
+      const Cone& c = cones_[i];
+      if (layout_.is_pinned(c.col_u) && layout_.is_pinned(c.col_v)) {
+        occupied_[key(c, layout_.y()[c.col_u], layout_.y()[c.col_v])] = cl_.copy_vertex[c.copy];
         continue;
       }
-      // Priority cones (those a previous run at this scale found doomed) go first, in the first
-      // batch, so that the later roundings can still be moved to fix their parity.
-      const double err = priority_[i]
-                             ? -1.0
-                             : std::max(std::abs(pu - std::round(pu)), std::abs(pv - std::round(pv)));
-      if (last || err < eps) batch.push_back({err, static_cast<int>(i)});
-    }
-    std::sort(batch.begin(), batch.end());
-    std::vector<Item> items;
-    for (const auto& [err, i] : batch) {
-      const int k = cand_[i].copy, comp = cl_.copy_component[k], vertex = cl_.copy_vertex[k];
-      const double pu = x_[2 * k], pv = x_[2 * k + 1];
-      std::vector<std::pair<double, std::pair<double, double>>> corners;
-      for (const double gu : {std::floor(pu), std::ceil(pu)})
-        for (const double gv : {std::floor(pv), std::ceil(pv)})
-          corners.push_back({std::hypot(gu - pu, gv - pv), {gu, gv}});
-      std::sort(corners.begin(), corners.end());
-      std::pair<double, double> pick = corners[0].second;
-      for (const auto& [dist, g] : corners) {
-        const auto it = occupied.find({comp, std::llround(g.first), std::llround(g.second)});
-        if (it == occupied.end() || it->second == vertex) {
-          pick = g;
-          break;
-        }
+      ++stats_->n_cone_collisions;
+      bool placed = false;
+      const std::vector<Eigen::Vector2d> choices = grid_choices(c);
+      size_t tried = 0;
+      for (size_t a = 0; a < choices.size() && tried < kConeAlternatives && !placed; ++a) {
+        if (out_of_time()) return Outcome::kOutOfTime;
+        std::vector<std::pair<int, double>> t;
+        if (!layout_.is_pinned(c.col_u)) t.push_back({c.col_u, choices[a].x()});
+        if (!layout_.is_pinned(c.col_v)) t.push_back({c.col_v, choices[a].y()});
+        // A grid point that leaves a triangle of pinned cones flat or reversed is skipped
+        // without a solve (e.g. a third cone of a triangle of cones on the line of the other two).
+        if (!layout_.determined_faces_valid(t)) continue;
+        ++tried;
+        ++stats_->n_reverted;
+        pin(t, cluster);
+        if (!status_.is_ok()) return Outcome::kFailed;
+        placed = layout_.is_pinned(c.col_u) && layout_.is_pinned(c.col_v);
       }
-      occupied[{comp, std::llround(pick.first), std::llround(pick.second)}] = vertex;
-      if (!decided_[i]) items.push_back({i, pick.first, pu});
-      if (!decided_[i + 1]) items.push_back({i + 1, pick.second, pv});
-    }
-    return items;
-  }
-  const param::ConstrainedReduction& reduction() const { return reduction_; }
-  int n_rows() const { return static_cast<int>(rows_.size()); }
-
- private:
-  param::AffineRow row_of(const Item& it) const {
-    param::AffineRow row;
-    row.entries = cand_[it.candidate].form;
-    row.rhs = it.rhs;
-    return row;
-  }
-
-  // Candidates that `items` (on top of the committed rows) would imply fractional: an
-  // elimination only, no solve.
-  std::vector<int> offenders_of(const std::vector<Item>& items) const {
-    std::vector<param::AffineRow> new_rows;
-    for (const Item& it : items) new_rows.push_back(row_of(it));
-    param::ConstrainedLayoutOptions reduce = lopt_;
-    reduce.reduce_only = true;
-    const param::ConstrainedLayoutResult res =
-        param::solve_constrained_layout(mesh_, cl_, x_, rows_, new_rows, reduce);
-    std::vector<int> offenders = implied_fractional(res.reduction, items);
-    return offenders;
-  }
-
-  // Parity repair before any solve: while the batch implies fractional candidates, move single
-  // roundings to their other neighbouring integer when that lowers the number of offenders
-  // (changing one coordinate of a ±1 cone by one flips the parity of (I − R)·x). Returns the
-  // offenders left (empty when the batch is parity-clean).
-  std::vector<int> repair_parity(std::vector<Item>* items) const {
-    std::vector<int> offenders = offenders_of(*items);
-    for (int pass = 0; pass < kParityRepairPasses && !offenders.empty(); ++pass) {
-      bool improved = false;
-      for (size_t i = 0; i < items->size() && !offenders.empty(); ++i) {
-        Item& it = (*items)[i];
-        const double kept = it.rhs;
-        it.rhs = it.value < kept ? kept - 1 : kept + 1;
-        std::vector<int> trial = offenders_of(*items);
-        if (trial.size() < offenders.size()) {
-          offenders = std::move(trial);
-          improved = true;
-        } else {
-          it.rhs = kept;
-        }
+      if (!placed) {
+        const Eigen::Vector2d p = position(c);
+        stuck_ = "cone vertex " + std::to_string(cl_.copy_vertex[c.copy]) + " at (" +
+                 std::to_string(p.x()) + ", " + std::to_string(p.y()) +
+                 ") reaches no free grid point flip-free";
+        return Outcome::kStuck;
       }
-      if (!improved) break;
+      occupied_[key(c, layout_.y()[c.col_u], layout_.y()[c.col_v])] = cl_.copy_vertex[c.copy];
+      report_progress("cones");
     }
-    return offenders;
+    return Outcome::kDone;
   }
 
-  bool try_items(std::vector<Item> items) {
-    last_offenders_ = repair_parity(&items);
-    if (!last_offenders_.empty()) {
-      ++n_failed_;
-      return false;
-    }
-    std::vector<param::AffineRow> new_rows;
-    for (const Item& it : items) new_rows.push_back(row_of(it));
-    param::ConstrainedLayoutResult res =
-        param::solve_constrained_layout(mesh_, cl_, x_, rows_, new_rows, lopt_);
-    stats_->n_iterations += res.iterations;
-    if (res.status.is_ok() && res.n_flipped == 0) {
-      for (size_t i = 0; i < items.size(); ++i) {
-        decided_[items[i].candidate] = 1;
-        if (res.independent[i]) rows_.push_back(new_rows[i]);
+  Outcome round_cones() {
+    std::vector<int> open(cones_.size());
+    std::iota(open.begin(), open.end(), 0);
+    // Clusters first, then the rest by distance to the nearest grid point in batches.
+    const std::vector<char> in_cluster = clustered(open);
+    std::vector<int> cluster_batch;
+    for (const int i : open)
+      if (in_cluster[i]) cluster_batch.push_back(i);
+    stats_->n_clustered_cones += static_cast<int>(cluster_batch.size());
+    if (!cluster_batch.empty())
+      if (const Outcome o = round_cone_batch(cluster_batch, true); o != Outcome::kDone) return o;
+    const int n_steps = std::max(1, static_cast<int>(std::ceil(0.5 / opt_.threshold_step - 1e-9)));
+    for (int step = 0; step < n_steps; ++step) {
+      const double eps = opt_.threshold_step * (step + 1);
+      std::vector<int> batch;
+      for (size_t i = 0; i < cones_.size(); ++i) {
+        const Cone& c = cones_[i];
+        if (layout_.is_pinned(c.col_u) && layout_.is_pinned(c.col_v)) continue;
+        const Eigen::Vector2d p = position(c);
+        const double err =
+            std::max(std::abs(p.x() - std::round(p.x())), std::abs(p.y() - std::round(p.y())));
+        if (step + 1 == n_steps || err < eps) batch.push_back(static_cast<int>(i));
       }
-      x_ = res.x;
-      ++stats_->n_batches;
-      return true;
+      if (batch.empty()) continue;
+      if (const Outcome o = round_cone_batch(batch, false); o != Outcome::kDone) return o;
     }
-    ++n_failed_;
-    if (res.status.code() == core::StatusCode::kNumericalFailure ||
-        res.status.code() == core::StatusCode::kInvalidInput)
-      hard_failure_ = res.status;
-    // Two cones of one face at the same point: a cone collision.
-    for (int f = 0; f < mesh_.n_faces() && res.x.size() == x_.size(); ++f)
-      for (int k = 0; k < 3; ++k) {
-        const int a = cl_.corner_copy[3 * f + k], b = cl_.corner_copy[3 * f + (k + 1) % 3];
-        if (is_cone_copy_[a] && is_cone_copy_[b] &&
-            res.x.segment<2>(2 * a) == res.x.segment<2>(2 * b)) {
-          ++stats_->n_cone_collisions;
-          f = mesh_.n_faces();
-          break;
-        }
-      }
-    return false;
+    return Outcome::kDone;
   }
 
-  // Candidates that the constraints now determine completely (an empty row of P) must come out
-  // as integers. A cone fixed through (I − R^r) by other integers can land on a half-integer:
-  // returns those (undecided) candidates; process() then rounds them first, from the current
-  // layout, so that the other roundings cannot force them onto the wrong parity.
-  std::vector<int> implied_fractional(const param::ConstrainedReduction& red,
-                                      const std::vector<Item>& items) const {
-    // Items are checked too: an item whose row depends on earlier rows is dropped by the
-    // elimination, and its implied value need not be its rounding.
-    // Pairs are checked as well: two undecided candidates with the same free part (P rows equal
-    // up to sign) and offsets that differ by a non-integer (a ± b = ½, typical of a ±1 cone and a
-    // translation through I − R) can never both be integers, which a greedy order would only see
-    // once one of them is fixed, too late to repair.
-    std::vector<int> offenders;
-    std::vector<double> rhs(cand_.size(), std::numeric_limits<double>::quiet_NaN());
-    for (const Item& it : items) rhs[it.candidate] = it.rhs;
-    std::map<std::vector<std::pair<int, double>>, std::pair<int, double>> free_part;
-    for (size_t i = 0; i < cand_.size(); ++i) {
-      if (decided_[i]) continue;
-      const int v = cand_[i].form[0].first;
-      if (red.P.row(v).nonZeros() != 0) {
-        std::vector<std::pair<int, double>> key;
-        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
-          key.push_back({static_cast<int>(it.col()), it.value()});
-        const double sign = key.front().second < 0 ? -1 : 1;
-        for (auto& [col, a] : key) a *= sign;
-        const double offset = sign * red.c[v];
-        const auto [pos, inserted] = free_part.try_emplace(key, static_cast<int>(i), offset);
-        const double diff = offset - pos->second.second;
-        if (!inserted && std::abs(diff - std::round(diff)) > kParityTolerance)
-          offenders.push_back(static_cast<int>(i));
-        continue;
+  // The remaining integer columns (translations and lone cone coordinates) to their nearest
+  // integers in one batch; a blocked one then tries its other neighbouring integer.
+  Outcome round_others() {
+    std::vector<std::pair<int, double>> targets;
+    for (const int j : int_cols_)
+      if (!layout_.is_pinned(j)) targets.push_back({j, std::round(layout_.y()[j])});
+    if (targets.empty()) return Outcome::kDone;
+    if (out_of_time()) return Outcome::kOutOfTime;
+    pin(targets);
+    if (!status_.is_ok()) return Outcome::kFailed;
+    report_progress("translations");
+    for (const auto& [j, value] : targets) {
+      if (layout_.is_pinned(j)) continue;
+      const double v = layout_.y()[j];
+      bool placed = false;
+      for (const double alt : {std::round(v), v < std::round(v) ? std::round(v) - 1 : std::round(v) + 1}) {
+        if (out_of_time()) return Outcome::kOutOfTime;
+        ++stats_->n_reverted;
+        pin({{j, alt}});
+        if (!status_.is_ok()) return Outcome::kFailed;
+        if ((placed = layout_.is_pinned(j))) break;
       }
-      if (std::abs(red.c[v] - std::round(red.c[v])) > kParityTolerance ||
-          (!std::isnan(rhs[i]) && std::abs(red.c[v] - rhs[i]) > kParityTolerance))
-        offenders.push_back(static_cast<int>(i));
-    }
-    return offenders;
-  }
-
-  // Commits the items, splitting the batch on failure.
-  bool process(const std::vector<Item>& items, bool final_batch) {
-    lopt_.relative_tolerance = final_batch ? kFinalTolerance : kBatchTolerance;
-    if (items.empty() || try_items(items)) return true;
-    if (!hard_failure_.is_ok() || n_failed_ >= kMaxFailedSolvesPerScale) return false;
-    ++stats_->n_reverted;
-    if (items.size() > 1) {
-      const size_t half = items.size() / 2;
-      return process({items.begin(), items.begin() + half}, final_batch) &&
-             process(refresh({items.begin() + half, items.end()}), final_batch);
-    }
-    // A single unknown: the same integer with a longer homotopy, then the other neighbour.
-    lopt_.homotopy_iterations = kSingleHomotopyIterations;
-    Item other = items[0];
-    other.rhs = other.value < other.rhs ? other.rhs - 1 : other.rhs + 1;
-    bool ok = try_items(items);
-    std::vector<int> offenders = last_offenders_;
-    if (!ok) {
-      ok = try_items({other});
-      // Both neighbours imply fractional candidates: the committed roundings already doom them.
-      if (!ok && !offenders.empty() && !last_offenders_.empty()) {
-        offenders.insert(offenders.end(), last_offenders_.begin(), last_offenders_.end());
-        for (const int o : offenders)
-          if (cand_[o].is_cone) doomed_.push_back(o - cand_[o].coord);
+      if (!placed) {
+        stuck_ = "a seam translation at " + std::to_string(v) + " reaches no integer flip-free";
+        return Outcome::kStuck;
       }
     }
-    lopt_.homotopy_iterations = 0;
-    return ok;
+    return Outcome::kDone;
   }
 
-  // Re-rounds items from the current layout (after part of their batch was committed).
-  std::vector<Item> refresh(std::vector<Item> items) const {
-    for (Item& it : items) {
-      it.value = cand_[it.candidate].value(x_);
-      it.rhs = std::round(it.value);
-    }
-    return items;
-  }
-
- public:
-  core::Status hard_failure_;
-
- private:
   const core::TriMesh& mesh_;
   const param::CopyLayout& cl_;
   const std::vector<Candidate>& cand_;
   const std::vector<char>& is_cone_copy_;
-  param::ConstrainedLayoutOptions lopt_;
+  const QuantizeOptions& opt_;
   QuantizeStats* stats_;
-  Eigen::VectorXd x_;
-  std::vector<char> decided_;
-  int n_failed_ = 0;  // failed re-optimizations at this scale
-  std::vector<int> last_offenders_;  // of the last try_items that failed its parity repair
-  std::vector<int> doomed_;          // u candidates of cone copies found doomed by parity
-  std::vector<char> priority_;       // per candidate (u candidate of a cone copy): round first
-  std::vector<param::AffineRow> rows_;
-  param::ConstrainedReduction reduction_;
+  Clock::time_point deadline_;
+  std::string label_;
+  param::PinnedLayout layout_;
+  core::Status status_;
+  std::vector<int> int_cols_;
+  std::vector<Cone> cones_;
+  std::map<GridKey, int> occupied_;  // grid points of pinned cones → their mesh vertex
+  int n_pinned_ = 0;
+  std::string stuck_;
 };
 
 // Whether a is a multiple of 2^-kMaxDenominatorBits (exactly).
@@ -490,6 +510,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   if (options.target_faces < 0 || !(options.edge_length >= 0) || !(options.threshold_step > 0) ||
       options.threshold_step > 0.5 || !(options.scale_growth > 1) ||
       options.max_scale_retries < 0 || options.near_scale_tries < 0 ||
+      !(options.time_budget_seconds >= 0) ||
       !(options.near_scale_step >= 0 && options.near_scale_step < 0.2)) {
     out.status = core::Status::invalid_input(
         "quantize options: need target_faces ≥ 0, edge_length ≥ 0, 0 < threshold_step ≤ 0.5, "
@@ -560,12 +581,18 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     return out;
   }
 
-  param::ConstrainedLayoutOptions lopt;
+  param::PinnedLayoutOptions lopt;
   lopt.energy = options.energy;
-  lopt.max_newton_iters = options.max_newton_iters;
   lopt.gauge_copies = gauge;
+  lopt.prefer_free = is_cone_copy;
+  const Clock::time_point deadline =
+      options.time_budget_seconds > 0
+          ? t0 + std::chrono::duration_cast<Clock::duration>(
+                     std::chrono::duration<double>(options.time_budget_seconds))
+          : Clock::time_point::max();
   std::optional<Eigen::VectorXd> best;
   core::Status failure;
+  std::string last_stuck;
   // Scales tried: the target, small jitters that keep the quad count within about ±8% (a
   // greedy rounding that dead-ends often succeeds from a slightly different start), then
   // refinements by scale_growth.
@@ -579,62 +606,57 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   for (int attempt = 0; attempt < static_cast<int>(scales.size()); ++attempt) {
     st.n_scale_retries = attempt;
     scale = scales[attempt];
-    // Scaled copies, each component translated so that its gauge copy is at the origin, then
-    // the seam translations.
-    Eigen::VectorXd x(n_copy_vars + 2 * cl.seams.size());
+    // Scaled copies, each component translated so that its gauge copy is at the origin.
+    Eigen::VectorXd x(n_copy_vars);
     for (int k = 0; k < cl.n_copies(); ++k)
       x.segment<2>(2 * k) =
           scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
-    for (size_t si = 0; si < cl.seams.size(); ++si) {
-      const param::CopySeam& s = cl.seams[si];
-      for (int d = 0; d < 2; ++d)
-        x[n_copy_vars + 2 * si + d] = x[2 * s.b0 + d] -
-                                      rotation_entry(s.matching, d, 0) * x[2 * s.a0] -
-                                      rotation_entry(s.matching, d, 1) * x[2 * s.a0 + 1];
-    }
     lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
-    // At one scale, a run that dead-ends on cones doomed by parity restarts with those cones
-    // rounded first (a few times), before the scale changes.
-    std::vector<char> priority(candidates.size(), 0);
-    std::optional<Rounder> found;
-    bool ok = false;
-    for (int restart = 0; restart <= kMaxPriorityRestarts; ++restart) {
-      found.emplace(mesh, cl, candidates, is_cone_copy, lopt, &st);
-      found->set_priority(priority);
-      ok = found->run(x, options.threshold_step, options.progress);
-      if (ok || !found->hard_failure_.is_ok()) break;
-      bool added = false;
-      for (const int u : found->doomed())
-        if (!priority[u]) priority[u] = added = true;
-      if (!added) break;
-    }
-    Rounder& rounder = *found;
-    if (!rounder.hard_failure_.is_ok()) {
-      failure = rounder.hard_failure_;
+    char label[32];
+    std::snprintf(label, sizeof label, "x%.3f", scale / scales[0]);
+    Rounder rounder(mesh, cl, candidates, is_cone_copy, options, &st, deadline, label);
+    const Rounder::Outcome outcome = rounder.run(x, lopt);
+    st.n_integer_dofs = rounder.n_integer_columns();
+    if (outcome == Rounder::Outcome::kFailed) {
+      failure = rounder.status();
       break;
     }
-    if (ok) {
-      Eigen::VectorXd xe;
-      std::string why;
-      if (!exact_expand(rounder.reduction(), rounder.x(), &xe, &why)) {
-        out.status = core::Status::internal("the constraint elimination is not dyadic (" + why +
-                                            "): no exact integer map");
-        st.seconds = seconds_since(t0);
-        return out;
-      }
-      st.scale = scale;
-      st.n_integer_dofs = rounder.n_rows();
-      st.n_rounded = st.n_candidates;
-      best = xe;
+    if (outcome == Rounder::Outcome::kOutOfTime) {
+      char msg[512];
+      std::snprintf(msg, sizeof msg,
+                    "quantization exceeded its time budget of %.0f s while rounding at scale "
+                    "x%.3f of the target (attempt %d of %zu, %d of %d integer unknowns rounded); "
+                    "a larger --time-budget, a larger --target-faces (fewer cone collisions) or "
+                    "a larger --cone-pair-distance may help",
+                    options.time_budget_seconds, scale / scales[0], attempt + 1, scales.size(),
+                    rounder.n_pinned(), rounder.n_integer_columns());
+      failure = core::Status::not_converged(msg);
       break;
     }
+    if (outcome == Rounder::Outcome::kStuck) {
+      last_stuck = rounder.stuck_reason();
+      continue;
+    }
+    Eigen::VectorXd xe;
+    std::string why;
+    if (!exact_expand(rounder.layout().reduction(), rounder.layout().x(), &xe, &why)) {
+      out.status = core::Status::internal("the constraint elimination is not dyadic (" + why +
+                                          "): no exact integer map");
+      st.seconds = seconds_since(t0);
+      return out;
+    }
+    st.scale = scale;
+    st.n_rounded = st.n_candidates;
+    best = xe;
+    break;
   }
   if (!best) {
-    out.status =
-        failure.is_ok()
-            ? core::Status::not_converged("no flip-free integer-seamless map within " +
-                                          std::to_string(scales.size()) + " scales")
-            : failure;
+    out.status = failure.is_ok()
+                     ? core::Status::not_converged(
+                           "no flip-free integer-seamless map within " +
+                           std::to_string(scales.size()) + " scales" +
+                           (last_stuck.empty() ? "" : " (last: " + last_stuck + ")"))
+                     : failure;
     st.seconds = seconds_since(t0);
     return out;
   }

@@ -4,6 +4,9 @@
 #include <libparam/constrained_layout.h>
 
 #include <Eigen/Geometry>
+#include <cmath>
+#include <tuple>
+#include <vector>
 
 #include "quantize_test_util.h"
 #include "test_util.h"
@@ -103,6 +106,151 @@ TEST(QuantizeSeamless, RejectsMismatchedSizesAndBadOptions) {
             core::StatusCode::kInvalidInput);
   p.uv.corner_uv.conservativeResize(5, 2);
   EXPECT_EQ(quantize::quantize_seamless(mesh, p).status.code(), core::StatusCode::kInvalidInput);
+}
+
+TEST(QuantizeSeamless, TimeBudgetStopsWithAMessage) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 300;
+  qo.time_budget_seconds = 1e-9;
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
+  EXPECT_EQ(q.status.code(), core::StatusCode::kNotConverged) << q.status.to_string();
+  EXPECT_NE(q.status.message().find("time budget"), std::string::npos) << q.status.message();
+  EXPECT_NE(q.status.message().find("scale"), std::string::npos) << q.status.message();
+  qo.time_budget_seconds = -1;
+  EXPECT_EQ(quantize::quantize_seamless(mesh, p, qo).status.code(),
+            core::StatusCode::kInvalidInput);
+}
+
+TEST(QuantizeSeamless, ProgressReportsRoundedUnknownsAndScale) {
+  const core::TriMesh mesh = load("torus.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 400;
+  std::vector<std::tuple<std::string, int, int>> calls;
+  qo.progress = [&](const std::string& stage, int step, int n) { calls.push_back({stage, step, n}); };
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
+  ASSERT_TRUE(q.status.is_ok()) << q.status.to_string();
+  ASSERT_FALSE(calls.empty());
+  for (const auto& [stage, step, n] : calls) {
+    EXPECT_EQ(stage.rfind("quantize x", 0), 0u) << stage;
+    EXPECT_LE(step, n) << stage;
+    EXPECT_EQ(n, q.stats.n_integer_dofs) << stage;
+  }
+  EXPECT_EQ(std::get<1>(calls.back()), std::get<2>(calls.back())) << "all unknowns rounded";
+}
+
+// Cones closer than a quad edge must still land on distinct grid points: at a density of a few
+// quads per cone the sphere's eight cones sit about one unit apart and are rounded jointly.
+TEST(QuantizeSeamless, ClusteredConesTakeDistinctGridPoints) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 10;
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
+  ASSERT_TRUE(q.status.is_ok()) << q.status.to_string();
+  EXPECT_GT(q.stats.n_clustered_cones, 0) << "the test no longer builds a cluster";
+  EXPECT_EQ(q.stats.n_flipped, 0);
+  EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
+  const core::UVMetrics um = core::compute_uv_metrics(q.uv);
+  EXPECT_EQ(um.n_flipped, 0);
+  EXPECT_EQ(um.n_degenerate, 0);
+  const quadex::ExtractResult ex = quadex::extract_quads(q.uv);
+  ASSERT_TRUE(ex.status.is_ok()) << ex.status.to_string();
+  const quadex::QuadMetrics qm = quadex::compute_quad_metrics(ex.quads);
+  EXPECT_EQ(qm.n_non_quads, 0);
+  EXPECT_TRUE(qm.manifold);
+  EXPECT_EQ(qm.euler_characteristic, 2);
+}
+
+// The lattice property the rounding relies on: with cone copies preferred free, every cone
+// coordinate and seam translation is an integer combination of free integer unknowns.
+TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
+  const core::TriMesh mesh = load("torus.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  param::CopyLayout cl;
+  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  std::vector<char> cone_vertex(mesh.n_vertices(), 0), cone_copy(cl.n_copies(), 0);
+  for (const param::ConeInfo& c : p.cones) cone_vertex[c.vertex] = 1;
+  for (int k = 0; k < cl.n_copies(); ++k) cone_copy[k] = cone_vertex[cl.copy_vertex[k]];
+  param::PinnedLayoutOptions po;
+  po.prefer_free = cone_copy;
+  Eigen::VectorXd x0 = 10 * cl.x;  // a few units per feature
+  param::PinnedLayout layout;
+  ASSERT_TRUE(layout.init(mesh, cl, x0, po).is_ok());
+  const param::ConstrainedReduction& red = layout.reduction();
+  const int n_copy_vars = 2 * cl.n_copies();
+  std::vector<char> candidate(red.P.rows(), 0);
+  for (int k = 0; k < cl.n_copies(); ++k)
+    if (cone_copy[k]) candidate[2 * k] = candidate[2 * k + 1] = 1;
+  for (int v = n_copy_vars; v < red.P.rows(); ++v) candidate[v] = 1;
+  int n_checked = 0;
+  for (int v = 0; v < red.P.rows(); ++v) {
+    if (!candidate[v]) continue;
+    ++n_checked;
+    EXPECT_EQ(red.c[v], std::round(red.c[v])) << "variable " << v;
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it) {
+      EXPECT_EQ(it.value(), std::round(it.value())) << "variable " << v;
+      EXPECT_TRUE(candidate[red.free_vars[it.col()]]) << "variable " << v << " uses column "
+                                                      << it.col();
+    }
+  }
+  EXPECT_GT(n_checked, 0);
+}
+
+TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  param::CopyLayout cl;
+  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  param::PinnedLayout layout;
+  ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, {}).is_ok());
+  ASSERT_EQ(layout.n_flipped(), 0);
+  // A free variable a tenth of a unit away from where it is.
+  const int j = layout.n_free() / 2;
+  const double target = layout.y()[j] + 0.1;
+  const param::PinReport ok = layout.pin({{j, target}}, {}, 5, 1e-4);
+  ASSERT_TRUE(ok.status.is_ok()) << ok.status.to_string();
+  ASSERT_EQ(ok.pinned.size(), 1u);
+  EXPECT_EQ(ok.pinned[0], 1);
+  EXPECT_TRUE(layout.is_pinned(j));
+  EXPECT_EQ(layout.y()[j], target);
+  EXPECT_EQ(layout.n_flipped(), 0);
+  // Both coordinates of the three copies of one face onto one line: the face is determined by
+  // its targets and degenerate, so the targets block and the layout stays flip-free.
+  const param::ConstrainedReduction& red = layout.reduction();
+  std::vector<int> col_of(red.P.rows(), -1);
+  for (size_t c = 0; c < red.free_vars.size(); ++c) col_of[red.free_vars[c]] = static_cast<int>(c);
+  int face = -1;
+  for (int f = 0; f < mesh.n_faces() && face < 0; ++f) {
+    bool all_free = true;
+    for (int k = 0; k < 3; ++k) {
+      const int copy = cl.corner_copy[3 * f + k];
+      all_free = all_free && col_of[2 * copy] >= 0 && col_of[2 * copy + 1] >= 0 &&
+                 !layout.is_pinned(col_of[2 * copy]) && !layout.is_pinned(col_of[2 * copy + 1]);
+    }
+    if (all_free) face = f;
+  }
+  ASSERT_GE(face, 0);
+  std::vector<std::pair<int, double>> collinear;
+  for (int k = 0; k < 3; ++k) {
+    const int copy = cl.corner_copy[3 * face + k];
+    collinear.push_back({col_of[2 * copy], 100.0 + k});
+    collinear.push_back({col_of[2 * copy + 1], 100.0 + k});
+  }
+  const param::PinReport blocked = layout.pin(collinear, {}, 5, 1e-4);
+  ASSERT_TRUE(blocked.status.is_ok()) << blocked.status.to_string();
+  for (size_t i = 0; i < collinear.size(); ++i) {
+    EXPECT_EQ(blocked.pinned[i], 0) << i;
+    EXPECT_EQ(blocked.blocking[i], 1) << i;
+  }
+  EXPECT_EQ(layout.n_flipped(), 0);
 }
 
 TEST(ConstrainedLayout, CopiesAndAffineRowsOnTheSphere) {

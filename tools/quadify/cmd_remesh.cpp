@@ -30,6 +30,7 @@ struct RemeshArgs {
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
+  double time_budget = 0;         // seconds for the quantization, 0 = none
 };
 
 
@@ -47,6 +48,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   quantize_options.edge_length = args.edge_length;
   quantize_options.threads = common.threads;
   quantize_options.progress = on_progress;
+  quantize_options.time_budget_seconds = args.time_budget;
 
   param::ParamOptions param_options = args.param;
   param_options.cone_pair_distance =
@@ -66,8 +68,11 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   const quantize::QuantizeResult integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
   progress.end();
   if (!integer_map.status.is_ok())
-    throw CliError{kExitInternal, args.input + ": quantization failed: " + integer_map.status.to_string() +
-                                      " (a larger --target-faces often helps)"};
+    throw CliError{kExitInternal,
+                   args.input + ": quantization failed: " + integer_map.status.to_string() +
+                       (integer_map.status.message().find("time budget") == std::string::npos
+                            ? " (a larger --target-faces often helps)"
+                            : "")};
 
   quadex::ExtractOptions extract_options;
   extract_options.output_uv = args.keep_uv;
@@ -113,6 +118,12 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
                         {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
                         {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
+                        {"clustered_cones", qs.n_clustered_cones},
+                        {"cone_collisions", qs.n_cone_collisions},
+                        {"newton_iterations", qs.n_iterations},
+                        {"seconds_setup", qs.seconds_setup},
+                        {"seconds_rounding", qs.seconds_rounding},
+                        {"seconds_final", qs.seconds_final},
                         {"seconds", qs.seconds}};
   const quadex::ExtractStats& es = extracted.stats;
   report["extract"] = {{"vertices", es.n_vertices}, {"faces", es.n_faces}, {"non_quads", es.n_non_quads},
@@ -186,6 +197,12 @@ CommandRunner register_remesh(CLI::App& app) {
                  "and add two irregular vertices (0 = keep every cone)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--time-budget", args->time_budget,
+                 "Stop the quantization after this many seconds with a message naming the scale and the "
+                 "stage reached (0 = no limit)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->type_name("SECONDS");
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -110,5 +111,99 @@ struct ConstrainedLayoutResult {
     const core::TriMesh& mesh, const CopyLayout& copies, const Eigen::VectorXd& x0,
     const std::vector<AffineRow>& old_rows, const std::vector<AffineRow>& new_rows,
     const ConstrainedLayoutOptions& options = {});
+
+
+// Flip-free layout optimization with pinned variables, for rounding free variables to integers
+// one batch after another (paper Def. 3.2) without rebuilding anything between batches.
+//
+// The seam constraints are eliminated once, x = P·y + c. The elimination keeps the coordinates of
+// the `prefer_free` copies (cone copies) free wherever it can and pivots on translations before
+// them, so that a seam translation becomes an integer combination of cone coordinates and free
+// translations (the loop around a cone, (I − R)·x_cone = Σ R·t, is solved for one t with a unit
+// coefficient instead of for x_cone with determinant 2 or 4). Rounding then pins free variables
+// y_j: a pinned row and column of the Hessian become the identity, so the Hessian pattern over y
+// never changes and its symbolic factorization and per-face element maps are computed once.
+struct PinnedLayoutOptions {
+  Energy energy = Energy::kSymmetricDirichlet;  // kTau is optimized as symmetric Dirichlet
+  // Rest shapes are the 3D triangles scaled by this factor (UV units per model unit).
+  double rest_scale = 1;
+  // One copy per component keeps its position (the translation gauge); -1 = the first copy.
+  std::vector<int> gauge_copies;
+  // Per copy (#copies, or empty): keep its coordinates as free variables where possible.
+  std::vector<char> prefer_free;
+};
+
+// Outcome of PinnedLayout::pin: targets that were reached flip-free are pinned; the others stay
+// free where the layout stopped (still flip-free).
+struct PinReport {
+  core::Status status;          // kNumericalFailure when a factorization failed
+  std::vector<char> pinned;     // per target
+  std::vector<char> blocking;   // per target not pinned: its move was limited by a face that
+                                // would flip (a cone collision or a fold), not by the budget
+  int iterations = 0;           // Newton steps (one factorization each)
+};
+
+struct PinSettings {
+  // Newton steps that move the targets (each the largest flip-free fraction of the remaining
+  // displacement, with the free variables re-optimized along).
+  int max_steps = 30;
+  // A step shorter than this fraction of the remaining displacement counts as stalled; after
+  // kStalledSteps of them the targets whose faces limit the step are dropped.
+  double stall_fraction = 0.05;
+  // Steps without reaching the targets after which the targets whose faces limit the step are
+  // dropped (they squeeze some region to zero area).
+  int approach_steps = 6;
+  // Penalty homotopy (0 stages = off) for targets that one flip-free step cannot reach: up to
+  // stage_iterations Newton iterations on energy + w·unit·Σ (y_j − target)², w from
+  // first_penalty growing by penalty_growth (unit: one triangle's stiffness), until every
+  // residual is below snap_residual (UV units) or the residuals stop shrinking.
+  int penalty_stages = 0;
+  int stage_iterations = 8;
+  double first_penalty = 1;
+  double penalty_growth = 10;
+  double snap_residual = 1e-3;
+};
+
+class PinnedLayout {
+ public:
+  PinnedLayout();
+  ~PinnedLayout();
+  PinnedLayout(PinnedLayout&&) noexcept;
+  PinnedLayout& operator=(PinnedLayout&&) noexcept;
+
+  // Eliminates the seam constraints of `copies` around the layout x0 (2·#copies, positively
+  // oriented faces, seamless up to round-off: it is projected onto the constraint space), builds
+  // the element maps and analyses the Hessian pattern.
+  // Returns kInvalidInput for wrong sizes or a flipped start, kNumericalFailure when the
+  // analysis fails.
+  [[nodiscard]] core::Status init(const core::TriMesh& mesh, const CopyLayout& copies,
+                                  const Eigen::VectorXd& x0, const PinnedLayoutOptions& options);
+
+  // x = P·y + c in the external order (2·#copies + 2·#seams, see solve_constrained_layout).
+  const ConstrainedReduction& reduction() const;
+  int n_free() const;
+  const Eigen::VectorXd& y() const;
+  Eigen::VectorXd x() const;  // external order
+  bool is_pinned(int j) const;
+  int n_flipped() const;  // exact predicate; 0 after init and after every call
+
+  // Moves free variables y_j to targets (j, value) flip-free, the other free variables following
+  // by Newton steps on energy with the targets' displacement prescribed, then pins the reached
+  // ones and relaxes with relax_iterations Newton iterations.
+  PinReport pin(const std::vector<std::pair<int, double>>& targets, const PinSettings& settings,
+                int relax_iterations, double relax_tolerance);
+
+  // Whether pinning `targets` (on top of the pinned variables) keeps every face that they alone
+  // determine positively oriented (exact predicate); pin() drops targets that fail this.
+  bool determined_faces_valid(const std::vector<std::pair<int, double>>& targets) const;
+
+  // Flip-free Newton minimisation of the energy over the unpinned variables. Returns the number
+  // of iterations; *status is kNumericalFailure when a factorization fails.
+  int minimize(int max_iterations, double relative_tolerance, core::Status* status);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace quadify::param

@@ -39,7 +39,11 @@ struct QuantizeOptions {
   double input_seam_tol = 1e-6;
   // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
   int threads = 0;
-  // Optional progress callback: stage "quantize", batch step of n_steps.
+  // Wall-clock limit of the quantization in seconds (0 = none). When it is exceeded the result
+  // is kNotConverged with a message naming the scale, the stage and what to try.
+  double time_budget_seconds = 0;
+  // Optional progress callback, once per batch: stage "quantize x<scale factor> cones" or
+  // "... translations", step = integer unknowns rounded so far of n_steps independent ones.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
 };
 
@@ -53,10 +57,14 @@ struct QuantizeStats {
   int n_batches = 0;        // constrained re-optimizations that succeeded
   int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
   int n_cones = 0;
-  int n_cone_collisions = 0;  // failed re-optimizations where two cones of a face coincided
-  int n_iterations = 0;       // Newton iterations in total
+  int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
+  int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
+  int n_iterations = 0;       // Newton iterations (one factorization each) in total
   double uv_area = 0;         // UV area of the result (≈ number of quads)
   double seconds = 0;
+  double seconds_setup = 0;     // elimination, element maps and symbolic analysis (per scale)
+  double seconds_rounding = 0;  // initial relaxation and the pinned batches
+  double seconds_final = 0;     // final relaxation
 };
 
 struct QuantizeResult {
