@@ -903,9 +903,19 @@ class Extractor {
         continue;
       }
       std::vector<int> verts, uvs;
+      for (int s : cycle) verts.push_back(he_vertex_[s]);
+      {
+        // A sliver between an iso-line and the boundary can close with two distinct vertices
+        // (seen on shark_b): no face; its two edges become one, which keeps the mesh manifold.
+        std::vector<int> distinct = verts;
+        std::sort(distinct.begin(), distinct.end());
+        if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3) {
+          ++res_.stats.n_dropped_faces;
+          continue;
+        }
+      }
       Transform to_current;  // chart of the first corner → chart of the current corner
       for (int s : cycle) {
-        verts.push_back(he_vertex_[s]);
         if (opt_.output_uv) {
           const Eigen::Vector2d p = inverse(to_current).apply(he_uv_[s]);
           uvs.push_back(static_cast<int>(face_uv_rows.size() / 2));

@@ -45,7 +45,9 @@ struct ExtractStats {
   // Boundary vertices lying exactly on an iso-line that touches the boundary there (e.g. a reflex
   // corner snapped onto it), moved off it by 16 dyadic units so the extraction stays consistent.
   int n_unsnapped_boundary_vertices = 0;
-  int n_dropped_faces = 0;  // half-edge chains that did not close into a face (not expected)
+  // Half-edge chains that did not close into a face (not expected), and closed chains with fewer
+  // than three distinct vertices (slivers between an iso-line and the boundary).
+  int n_dropped_faces = 0;
   double max_transition_residual = 0;  // measured, in UV units
   double seconds = 0;
 };
