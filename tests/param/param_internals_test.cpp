@@ -145,40 +145,52 @@ TEST(DistortionEnergy, DerivativesMatchFiniteDifferences) {
   EXPECT_FALSE(evaluate_density(Density::kSymmetricDirichlet, 1, Eigen::Vector2d(1, -1).asDiagonal().toDenseMatrix(), false, false).finite);
 }
 
-TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
-  const core::TriMesh m = test::make_icosphere(2);
-  const CutMesh cut = cut_along_dual_tree(m, 0);
-  const LayoutDomain dom = make_domain(cut);
-  Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
-  std::vector<char> gauge(x.size(), 0);
-  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
-  ConstraintEliminator elim(static_cast<int>(x.size()), gauge);
-  const Reduction red0 = elim.reduction(x);
-  Eigen::MatrixX2d xm = isometric_unfold(m, cut);
-  const auto meas = measure_matchings(cut, xm);
+// The isometric unfold of m moved into the constraints of its nearest-integer matchings.
+struct RoundedStart {
+  CutMesh cut;
+  LayoutDomain dom;
+  Eigen::VectorXd x;
   std::vector<SparseRow> rows;
+  TransitionReport tr;
+};
+RoundedStart move_into_rounded_constraints(const core::TriMesh& m) {
+  RoundedStart r;
+  r.cut = cut_along_dual_tree(m, 0);
+  r.dom = make_domain(r.cut);
+  r.x = flatten(isometric_unfold(m, r.cut));
+  std::vector<char> gauge(r.x.size(), 0);
+  gauge[2 * r.cut.root_copy] = gauge[2 * r.cut.root_copy + 1] = 1;
+  ConstraintEliminator elim(static_cast<int>(r.x.size()), gauge);
+  const Reduction red0 = elim.reduction(r.x);
+  const auto meas = measure_matchings(r.cut, isometric_unfold(m, r.cut));
   double edge_sq = 0, area = 0;
-  for (size_t s = 0; s < cut.seams.size(); ++s) {
-    for (const auto& r : seam_constraint_rows(cut, static_cast<int>(s), std::lround(meas[s]))) {
-      elim.add_row(r);
-      rows.push_back(r);
+  for (size_t s = 0; s < r.cut.seams.size(); ++s) {
+    for (const auto& row : seam_constraint_rows(r.cut, static_cast<int>(s), std::lround(meas[s]))) {
+      elim.add_row(row);
+      r.rows.push_back(row);
     }
-    edge_sq += seam_length(cut, static_cast<int>(s)) * seam_length(cut, static_cast<int>(s));
+    edge_sq += seam_length(r.cut, static_cast<int>(s)) * seam_length(r.cut, static_cast<int>(s));
   }
-  for (double a : cut.area) area += a;
-  TransitionReport tr = move_into_constraints(dom, red0, elim, rows, area / edge_sq, &x);
+  for (double a : r.cut.area) area += a;
+  r.tr = move_into_constraints(r.dom, red0, elim, r.rows, area / edge_sq, &r.x);
+  return r;
+}
+
+TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
+  RoundedStart r = move_into_rounded_constraints(test::make_icosphere(2));
+  const TransitionReport& tr = r.tr;
   ASSERT_TRUE(tr.status.is_ok()) << tr.status.to_string();
-  Eigen::VectorXd y = tr.reduction.restrict(x);
+  Eigen::VectorXd y = tr.reduction.restrict(r.x);
   OptimizeSettings st;
-  const OptimizeReport rep = optimize_layout(dom, tr.reduction, st, &y);
+  const OptimizeReport rep = optimize_layout(r.dom, tr.reduction, st, &y);
   ASSERT_TRUE(rep.status.is_ok()) << rep.status.to_string();
   EXPECT_LE(rep.energy, rep.initial_energy);
-  x = tr.reduction.expand(y);
-  EXPECT_EQ(count_flipped(dom, x), 0);
+  const Eigen::VectorXd x = tr.reduction.expand(y);
+  EXPECT_EQ(count_flipped(r.dom, x), 0);
   double worst = 0;
-  for (const auto& r : rows) {
+  for (const auto& row : r.rows) {
     double v = 0;
-    for (const auto& [var, c] : r.entries) v += c * x[var];
+    for (const auto& [var, c] : row.entries) v += c * x[var];
     worst = std::max(worst, std::abs(v));
   }
   EXPECT_LT(worst, 1e-12);
@@ -187,28 +199,10 @@ TEST(LayoutOptimizer, SeamlessSphereIsFlipFreeWithExactSeams) {
 // One LayoutProblem reused over a sequence of optimizations (other densities and powers, as the τ
 // continuation runs them) gives bit-identical layouts to building the problem for each one.
 TEST(LayoutOptimizer, ReusedProblemMatchesFreshProblems) {
-  const core::TriMesh m = test::make_icosphere(3);  // sparse mode: > 250 reduced variables
-  const CutMesh cut = cut_along_dual_tree(m, 0);
-  const LayoutDomain dom = make_domain(cut);
-  Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
-  std::vector<char> gauge(x.size(), 0);
-  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
-  ConstraintEliminator elim(static_cast<int>(x.size()), gauge);
-  const Reduction red0 = elim.reduction(x);
-  const auto meas = measure_matchings(cut, isometric_unfold(m, cut));
-  std::vector<SparseRow> rows;
-  double edge_sq = 0, area = 0;
-  for (size_t s = 0; s < cut.seams.size(); ++s) {
-    for (const auto& r : seam_constraint_rows(cut, static_cast<int>(s), std::lround(meas[s]))) {
-      elim.add_row(r);
-      rows.push_back(r);
-    }
-    edge_sq += seam_length(cut, static_cast<int>(s)) * seam_length(cut, static_cast<int>(s));
-  }
-  for (double a : cut.area) area += a;
-  TransitionReport tr = move_into_constraints(dom, red0, elim, rows, area / edge_sq, &x);
+  RoundedStart r = move_into_rounded_constraints(test::make_icosphere(3));  // > 250 variables
+  const TransitionReport& tr = r.tr;
   ASSERT_TRUE(tr.status.is_ok()) << tr.status.to_string();
-  ASSERT_GT(tr.reduction.n_free(), 250);
+  ASSERT_GT(tr.reduction.n_free(), 250) << "sparse mode";
   std::vector<OptimizeSettings> sequence(4);
   sequence[1].density = Density::kPowerSD;
   sequence[1].power = 2;
@@ -216,10 +210,10 @@ TEST(LayoutOptimizer, ReusedProblemMatchesFreshProblems) {
   sequence[2].power = 8;
   sequence[3].density = Density::kArap;
   for (OptimizeSettings& st : sequence) st.max_iterations = 8;
-  Eigen::VectorXd y_fresh = tr.reduction.restrict(x), y_reused = y_fresh;
-  LayoutProblem problem(dom, tr.reduction);
+  Eigen::VectorXd y_fresh = tr.reduction.restrict(r.x), y_reused = y_fresh;
+  LayoutProblem problem(r.dom, tr.reduction);
   for (const OptimizeSettings& st : sequence) {
-    const OptimizeReport fresh = optimize_layout(dom, tr.reduction, st, &y_fresh);
+    const OptimizeReport fresh = optimize_layout(r.dom, tr.reduction, st, &y_fresh);
     const OptimizeReport reused = optimize_layout(problem, st, &y_reused);
     ASSERT_TRUE(fresh.status.is_ok()) << fresh.status.to_string();
     ASSERT_TRUE(reused.status.is_ok()) << reused.status.to_string();
@@ -229,7 +223,7 @@ TEST(LayoutOptimizer, ReusedProblemMatchesFreshProblems) {
     EXPECT_EQ(fresh.energy, reused.energy);
     ASSERT_EQ((y_fresh - y_reused).cwiseAbs().maxCoeff(), 0.0);
   }
-  EXPECT_EQ(count_flipped(dom, tr.reduction.expand(y_reused)), 0);
+  EXPECT_EQ(count_flipped(r.dom, tr.reduction.expand(y_reused)), 0);
 }
 
 TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
