@@ -59,6 +59,25 @@ SparseRow compress(const std::map<int, double>& acc) {
   return row;
 }
 
+// The copy fixed per component (translation gauge): gauge[comp] when given and valid, else the
+// component's first copy.
+std::vector<int> gauge_fixed_copies(const CopyLayout& copies, const std::vector<int>& gauge) {
+  const int n = copies.n_copies();
+  std::vector<char> gauge_set(copies.n_components, 0);
+  std::vector<int> fixed;
+  auto fix_copy = [&](int k) {
+    fixed.push_back(k);
+    gauge_set[copies.copy_component[k]] = 1;
+  };
+  for (int comp = 0; comp < copies.n_components; ++comp) {
+    const int g = gauge.empty() ? -1 : gauge[comp];
+    if (g >= 0 && g < n && copies.copy_component[g] == comp) fix_copy(g);
+  }
+  for (int k = 0; k < n; ++k)
+    if (copies.copy_component[k] >= 0 && !gauge_set[copies.copy_component[k]]) fix_copy(k);
+  return fixed;
+}
+
 }  // namespace
 
 core::Status build_copy_layout(const core::TriMesh& mesh, const Eigen::MatrixX2d& corner_uv,
@@ -232,17 +251,8 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
 
   std::vector<char> never_pivot(n_vars, 0);
   never_pivot[kOne] = never_pivot[kOne + 1] = 1;
-  std::vector<char> gauge_set(copies.n_components, 0);
-  auto fix_copy = [&](int k) {
+  for (int k : gauge_fixed_copies(copies, options.gauge_copies))
     never_pivot[x_base + 2 * k] = never_pivot[x_base + 2 * k + 1] = 1;
-    gauge_set[copies.copy_component[k]] = 1;
-  };
-  for (int comp = 0; comp < copies.n_components; ++comp) {
-    const int g = options.gauge_copies.empty() ? -1 : options.gauge_copies[comp];
-    if (g >= 0 && g < n && copies.copy_component[g] == comp) fix_copy(g);
-  }
-  for (int k = 0; k < n; ++k)
-    if (copies.copy_component[k] >= 0 && !gauge_set[copies.copy_component[k]]) fix_copy(k);
 
   // Seam rows: x_b0 − R^r x_a0 − t = 0 and x_b1 − R^r x_a1 − t = 0.
   ConstraintEliminator elim(n_vars, never_pivot);
@@ -399,26 +409,6 @@ constexpr double kPinShrink = 0.5;
 // is held back by the barrier (it blocks).
 constexpr double kPinHeldBack = 0.05;
 
-// Smallest positive t with det(X + t·D) = 0 (+inf when the orientation never changes).
-double flip_root(const Eigen::Matrix2d& X, const Eigen::Matrix2d& D) {
-  const double c0 = X.determinant();
-  const double c2 = D.determinant();
-  const double c1 = X(0, 0) * D(1, 1) + D(0, 0) * X(1, 1) - X(0, 1) * D(1, 0) - D(0, 1) * X(1, 0);
-  double root = std::numeric_limits<double>::infinity();
-  if (c2 == 0) {
-    if (c1 < 0) root = -c0 / c1;
-  } else {
-    const double disc = c1 * c1 - 4 * c2 * c0;
-    if (disc >= 0) {
-      const double sq = std::sqrt(disc);
-      const double q = -0.5 * (c1 + (c1 >= 0 ? sq : -sq));
-      const double r1 = q / c2, r2 = q != 0 ? c0 / q : std::numeric_limits<double>::infinity();
-      if (r1 > 0) root = std::min(root, r1);
-      if (r2 > 0) root = std::min(root, r2);
-    }
-  }
-  return root;
-}
 
 }  // namespace
 
@@ -665,17 +655,8 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
 
   std::vector<char> never_pivot(n_vars, 0);
   never_pivot[0] = never_pivot[1] = 1;
-  std::vector<char> gauge_set(copies.n_components, 0);
-  auto fix_copy = [&](int k) {
+  for (int k : gauge_fixed_copies(copies, options.gauge_copies))
     never_pivot[2 * copy_slot[k]] = never_pivot[2 * copy_slot[k] + 1] = 1;
-    gauge_set[copies.copy_component[k]] = 1;
-  };
-  for (int comp = 0; comp < copies.n_components; ++comp) {
-    const int g = options.gauge_copies.empty() ? -1 : options.gauge_copies[comp];
-    if (g >= 0 && g < n && copies.copy_component[g] == comp) fix_copy(g);
-  }
-  for (int k = 0; k < n; ++k)
-    if (copies.copy_component[k] >= 0 && !gauge_set[copies.copy_component[k]]) fix_copy(k);
   ConstraintEliminator elim(n_vars, never_pivot);
   for (int si = 0; si < n_seams; ++si) {
     const CopySeam& s = copies.seams[si];

@@ -363,31 +363,34 @@ double max_flip_free_step(const LayoutDomain& domain, const Eigen::VectorXd& x,
       D(d, 0) = dx[2 * fc[1] + d] - dx[2 * fc[0] + d];
       D(d, 1) = dx[2 * fc[2] + d] - dx[2 * fc[0] + d];
     }
-    const double c0 = X.determinant();
-    if (!(c0 > 0)) continue;
-    const double c2 = D.determinant();
-    const double c1 = X(0, 0) * D(1, 1) + D(0, 0) * X(1, 1) - X(0, 1) * D(1, 0) - D(0, 1) * X(1, 0);
-    // Smallest positive root of c2 t² + c1 t + c0.
-    double root = std::numeric_limits<double>::infinity();
-    if (c2 == 0) {
-      if (c1 < 0) root = -c0 / c1;
-    } else {
-      const double disc = c1 * c1 - 4 * c2 * c0;
-      if (disc >= 0) {
-        const double sq = std::sqrt(disc);
-        // Numerically stable roots.
-        const double q = -0.5 * (c1 + (c1 >= 0 ? sq : -sq));
-        const double r1 = q / c2, r2 = q != 0 ? c0 / q : std::numeric_limits<double>::infinity();
-        if (r1 > 0) root = std::min(root, r1);
-        if (r2 > 0) root = std::min(root, r2);
-      }
-    }
-    t_max = std::min(t_max, root);
+    if (!(X.determinant() > 0)) continue;
+    t_max = std::min(t_max, flip_root(X, D));
   }
   return t_max;
 }
 
 }  // namespace
+
+double flip_root(const Eigen::Matrix2d& X, const Eigen::Matrix2d& D) {
+  const double c0 = X.determinant();
+  const double c2 = D.determinant();
+  const double c1 = X(0, 0) * D(1, 1) + D(0, 0) * X(1, 1) - X(0, 1) * D(1, 0) - D(0, 1) * X(1, 0);
+  double root = std::numeric_limits<double>::infinity();
+  if (c2 == 0) {
+    if (c1 < 0) root = -c0 / c1;
+  } else {
+    const double disc = c1 * c1 - 4 * c2 * c0;
+    if (disc >= 0) {
+      const double sq = std::sqrt(disc);
+      // Numerically stable roots.
+      const double q = -0.5 * (c1 + (c1 >= 0 ? sq : -sq));
+      const double r1 = q / c2, r2 = q != 0 ? c0 / q : std::numeric_limits<double>::infinity();
+      if (r1 > 0) root = std::min(root, r1);
+      if (r2 > 0) root = std::min(root, r2);
+    }
+  }
+  return root;
+}
 
 LayoutDomain make_domain(const CutMesh& cut) {
   LayoutDomain d;

@@ -26,6 +26,10 @@ struct LayoutDomain {
 
 LayoutDomain make_domain(const CutMesh& cut);
 
+// Smallest positive t with det(X + t·D) = 0, X and D the edge matrices of a face and of its
+// displacement (+inf when the orientation never changes along the step).
+double flip_root(const Eigen::Matrix2d& X, const Eigen::Matrix2d& D);
+
 struct OptimizeSettings {
   Density density = Density::kSymmetricDirichlet;
   double power = 1;             // exponent of the power densities
