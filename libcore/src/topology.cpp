@@ -1,6 +1,10 @@
 #include <libcore/topology.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -151,6 +155,24 @@ TopologyStats topology_stats(const TriMesh& mesh) {
     s.genus = twice >= 0 && twice % 2 == 0 ? twice / 2 : -1;
   }
   return s;
+}
+
+std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, double angle_deg) {
+  auto normal = [&](int f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  const double cos_threshold = std::cos(angle_deg * std::numbers::pi / 180.0);
+  std::vector<int> sharp;
+  for (int e = 0; e < topo.n_edges(); ++e) {
+    const int h = topo.edge_halfedge[e], t = topo.twin[h];
+    if (t < 0) continue;
+    const Eigen::Vector3d n0 = normal(h / 3), n1 = normal(t / 3);
+    const double len = n0.norm() * n1.norm();
+    if (len > 0 && n0.dot(n1) / len < cos_threshold) sharp.push_back(e);
+  }
+  return sharp;
 }
 
 }  // namespace quadify::core

@@ -657,7 +657,14 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   never_pivot[0] = never_pivot[1] = 1;
   for (int k : gauge_fixed_copies(copies, options.gauge_copies))
     never_pivot[2 * copy_slot[k]] = never_pivot[2 * copy_slot[k] + 1] = 1;
-  ConstraintEliminator elim(n_vars, never_pivot);
+  std::vector<char> pivot_last(n_vars, 0);
+  if (!options.prefer_free_coords.empty()) {
+    if (static_cast<int>(options.prefer_free_coords.size()) != 2 * n)
+      return core::Status::invalid_input("PinnedLayout: prefer_free_coords has the wrong size");
+    for (int k = 0; k < n; ++k)
+      for (int d = 0; d < 2; ++d) pivot_last[2 * copy_slot[k] + d] = options.prefer_free_coords[2 * k + d];
+  }
+  ConstraintEliminator elim(n_vars, never_pivot, pivot_last);
   for (int si = 0; si < n_seams; ++si) {
     const CopySeam& s = copies.seams[si];
     for (const auto& [a, b] : {std::pair{s.a0, s.b0}, std::pair{s.a1, s.b1}})
@@ -670,6 +677,15 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
         acc[2 * seam_slot[si] + d] -= 1;
         elim.add_row(compress(acc));
       }
+  }
+  for (const AffineRow& row : options.extra_rows) {
+    std::map<int, double> acc;
+    for (const auto& [var, coef] : row.entries) {
+      if (var < 0 || var >= 2 * n)
+        return core::Status::invalid_input("PinnedLayout: extra row variable out of range");
+      acc[2 * copy_slot[var / 2] + var % 2] += coef;
+    }
+    elim.add_row(compress(acc));
   }
   Eigen::VectorXd xi = Eigen::VectorXd::Zero(n_vars);
   xi[0] = 1;

@@ -18,13 +18,16 @@ Eigen::VectorXd Reduction::restrict(const Eigen::VectorXd& x) const {
   return y;
 }
 
-ConstraintEliminator::ConstraintEliminator(int n_vars, std::vector<char> never_pivot)
+ConstraintEliminator::ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
+                                           std::vector<char> pivot_last)
     : expr_(n_vars),
       dependent_(n_vars, 0),
       never_pivot_(std::move(never_pivot)),
+      pivot_last_(std::move(pivot_last)),
       users_(n_vars),
       scratch_(n_vars, 0.0) {
   never_pivot_.resize(n_vars, 0);
+  pivot_last_.resize(n_vars, 0);
 }
 
 int ConstraintEliminator::max_expression_length() const {
@@ -55,16 +58,23 @@ bool ConstraintEliminator::add_row(const SparseRow& row) {
   }
   if (reduced.empty()) return false;
 
-  // Pivot: unit coefficient, newest variable; else the largest coefficient.
-  int best = -1;
+  // Pivot: unit coefficient, newest variable (pivot_last ones only when no other has a unit
+  // coefficient); else the largest coefficient.
+  int best = -1, best_last = -1;
   for (int i = static_cast<int>(reduced.size()) - 1; i >= 0; --i) {
     if (never_pivot_[reduced[i].first]) continue;
     if (std::abs(std::abs(reduced[i].second) - 1.0) < kZeroCoefficient) {
-      best = i;
-      break;
+      if (!pivot_last_[reduced[i].first]) {
+        best = i;
+        break;
+      }
+      if (best_last < 0) best_last = i;
+      continue;
     }
     if (best < 0 || std::abs(reduced[i].second) > std::abs(reduced[best].second)) best = i;
   }
+  if (best_last >= 0 && (best < 0 || std::abs(std::abs(reduced[best].second) - 1.0) >= kZeroCoefficient))
+    best = best_last;
   // A translation-free row cannot involve the gauge variables only.
   if (best < 0) return false;
   const int p = reduced[best].first;

@@ -31,8 +31,11 @@ struct Reduction {
 // Redundant rows (dependent on earlier ones, e.g. around vertices) are detected and dropped.
 class ConstraintEliminator {
  public:
-  // never_pivot[v]: variable v stays free (the translation gauge).
-  ConstraintEliminator(int n_vars, std::vector<char> never_pivot);
+  // never_pivot[v]: variable v stays free (the translation gauge). pivot_last[v] (may be empty):
+  // v is pivoted on only when no other variable of the row has a unit coefficient (e.g. variables
+  // that will be pinned to integers, which must stay integer combinations of free ones).
+  ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
+                       std::vector<char> pivot_last = {});
   // Returns true if the row was independent of the previous ones.
   bool add_row(const SparseRow& row);
   int rank() const { return rank_; }
@@ -47,6 +50,7 @@ class ConstraintEliminator {
   std::vector<Expr> expr_;                           // empty when free
   std::vector<char> dependent_;
   std::vector<char> never_pivot_;
+  std::vector<char> pivot_last_;
   std::vector<std::vector<int>> users_;              // dependents that may reference a variable
   std::vector<double> scratch_;
   int rank_ = 0;

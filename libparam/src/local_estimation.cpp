@@ -1,6 +1,7 @@
 #include "local_estimation.h"
 
 #include <algorithm>
+#include <array>
 #include <climits>
 #include <cmath>
 #include <limits>
@@ -15,8 +16,9 @@ constexpr double kPatchTolerance = 1e-6;
 }  // namespace
 
 LocalEstimator::LocalEstimator(const core::TriMesh& mesh, const CutMesh& cut,
-                               const LayoutDomain& domain, int bfs_levels)
-    : mesh_(mesh), cut_(cut), domain_(domain), levels_(bfs_levels) {
+                               const LayoutDomain& domain, int bfs_levels,
+                               const FeatureSet* features)
+    : mesh_(mesh), cut_(cut), domain_(domain), levels_(bfs_levels), features_(features) {
   vertex_faces_.resize(mesh.n_vertices());
   for (int f = 0; f < mesh.n_faces(); ++f)
     for (int k = 0; k < 3; ++k) vertex_faces_[mesh.F(f, k)].push_back(f);
@@ -26,8 +28,12 @@ LocalEstimator::LocalEstimator(const core::TriMesh& mesh, const CutMesh& cut,
 
 std::vector<int> LocalEstimator::patch_faces(int seam) const {
   const int fa = cut_.seams[seam].he_a / 3, ka = cut_.seams[seam].he_a % 3;
+  return patch_faces_around(mesh_.F(fa, ka), mesh_.F(fa, (ka + 1) % 3));
+}
+
+std::vector<int> LocalEstimator::patch_faces_around(int v0, int v1) const {
   std::vector<char> in_face(mesh_.n_faces(), 0), in_vertex(mesh_.n_vertices(), 0);
-  std::vector<int> faces, frontier = {mesh_.F(fa, ka), mesh_.F(fa, (ka + 1) % 3)};
+  std::vector<int> faces, frontier = {v0, v1};
   for (int v : frontier) in_vertex[v] = 1;
   for (int level = 0; level < levels_; ++level) {
     std::vector<int> next;
@@ -48,11 +54,14 @@ std::vector<int> LocalEstimator::patch_faces(int seam) const {
   return faces;
 }
 
-PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<int>& rounded,
-                                   const Eigen::VectorXd& x, Density density, double power) const {
-  PatchChoice choice;
-  const std::vector<int> faces = patch_faces(seam);
-  choice.n_faces = static_cast<int>(faces.size());
+LocalEstimator::Alternatives LocalEstimator::evaluate(
+    int v0, int v1, int skip_seam, int skip_feature,
+    const std::array<std::vector<SparseRow>, 2>& alternative, double edge_length,
+    const std::vector<int>& rounded, const std::vector<int>& labels, const Eigen::VectorXd& x,
+    Density density, double power) const {
+  Alternatives out{};
+  const std::vector<int> faces = patch_faces_around(v0, v1);
+  out.n_faces = static_cast<int>(faces.size());
   // Local copies (global copy → local id, in increasing global order so pivots stay "newest").
   std::vector<int> copies;
   for (int f : faces)
@@ -77,38 +86,47 @@ PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<i
   }
   Eigen::VectorXd x0(2 * dom.n_copies);
   for (int i = 0; i < dom.n_copies; ++i) x0.segment<2>(2 * i) = x.segment<2>(2 * copies[i]);
-  auto local_rows = [&](int s, int r) {
-    auto rows = seam_constraint_rows(cut_, s, r);
-    for (auto& row : rows)
-      for (auto& e : row.entries) e.first = 2 * local(e.first / 2) + e.first % 2;
-    return rows;
+  auto to_local = [&](SparseRow row) {
+    for (auto& e : row.entries) e.first = 2 * local(e.first / 2) + e.first % 2;
+    std::sort(row.entries.begin(), row.entries.end());
+    return row;
   };
   std::vector<char> gauge(2 * dom.n_copies, 0);
   gauge[0] = gauge[1] = 1;
   ConstraintEliminator base(2 * dom.n_copies, gauge);
-  std::vector<char> seen_seam(cut_.seams.size(), 0);
+  std::vector<char> seen_seam(cut_.seams.size(), 0), seen_feature;
+  if (features_) seen_feature.assign(features_->size(), 0);
   for (int f : faces)
     for (int k = 0; k < 3; ++k) {
-      const int s = edge_seam_[cut_.topo.face_edge(f, k)];
-      if (s < 0 || s == seam || seen_seam[s] || rounded[s] == INT_MIN) continue;
-      seen_seam[s] = 1;
-      const CutSeam& cs = cut_.seams[s];
-      if (!face_in[cs.he_a / 3] || !face_in[cs.he_b / 3]) continue;
-      for (const auto& row : local_rows(s, rounded[s])) base.add_row(row);
+      const int e = cut_.topo.face_edge(f, k);
+      const int s = edge_seam_[e];
+      if (s >= 0 && s != skip_seam && !seen_seam[s] && rounded[s] != INT_MIN) {
+        seen_seam[s] = 1;
+        const CutSeam& cs = cut_.seams[s];
+        if (face_in[cs.he_a / 3] && face_in[cs.he_b / 3])
+          for (const auto& row : seam_constraint_rows(cut_, s, rounded[s]))
+            base.add_row(to_local(row));
+      }
+      const int i = features_ ? features_->edge_feature[e] : -1;
+      if (i >= 0 && i != skip_feature && !seen_feature[i] && (labels[i] == 0 || labels[i] == 1) &&
+          face_in[features_->halfedge[i] / 3]) {
+        seen_feature[i] = 1;
+        base.add_row(to_local(feature_row(cut_, features_->halfedge[i], labels[i])));
+      }
     }
   const Reduction base_red = base.reduction(x0);
-  const int lo = static_cast<int>(std::floor(measure));
   for (int side = 0; side < 2; ++side) {
     ConstraintEliminator elim = base;
     std::vector<SparseRow> rows;
-    for (const auto& row : local_rows(seam, lo + side)) {
-      elim.add_row(row);
-      rows.push_back(row);
+    for (const auto& row : alternative[side]) {
+      rows.push_back(to_local(row));
+      elim.add_row(rows.back());
     }
     Eigen::VectorXd xs = x0;
-    const double edge_sq = seam_length(cut_, seam) * seam_length(cut_, seam);
-    TransitionReport tr = move_into_constraints(dom, base_red, elim, rows, area / edge_sq, &xs);
+    TransitionReport tr =
+        move_into_constraints(dom, base_red, elim, rows, area / (edge_length * edge_length), &xs);
     double value = std::numeric_limits<double>::infinity();
+    double tau = std::numeric_limits<double>::infinity();
     if (tr.status.is_ok()) {
       Eigen::VectorXd y = tr.reduction.restrict(xs);
       OptimizeSettings st;
@@ -117,10 +135,40 @@ PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<i
       st.max_iterations = kPatchIterations;
       st.relative_tolerance = kPatchTolerance;
       const OptimizeReport rep = optimize_layout(dom, tr.reduction, st, &y);
-      if (rep.status.is_ok()) value = rep.energy;
+      if (rep.status.is_ok()) {
+        value = rep.energy;
+        const Eigen::VectorXd xl = tr.reduction.expand(y);
+        double s1max = 0, s2min = std::numeric_limits<double>::infinity();
+        for (int f = 0; f < dom.n_faces(); ++f) {
+          const Eigen::Matrix2d J = face_jacobian(dom, f, xl);
+          const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+          const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+          s1max = std::max(s1max, 0.5 * (ps + pa));
+          s2min = std::min(s2min, 0.5 * (ps - pa));
+        }
+        if (s2min > 0) tau = std::sqrt(s1max / s2min);
+      }
     }
-    choice.distortion[side] = value;
+    out.energy[side] = value;
+    out.tau[side] = tau;
   }
+  return out;
+}
+
+PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<int>& rounded,
+                                   const std::vector<int>& labels, const Eigen::VectorXd& x,
+                                   Density density, double power) const {
+  PatchChoice choice;
+  const int lo = static_cast<int>(std::floor(measure));
+  std::array<std::vector<SparseRow>, 2> alt;
+  for (int side = 0; side < 2; ++side)
+    for (const auto& row : seam_constraint_rows(cut_, seam, lo + side)) alt[side].push_back(row);
+  const int fa = cut_.seams[seam].he_a / 3, ka = cut_.seams[seam].he_a % 3;
+  const Alternatives a = evaluate(mesh_.F(fa, ka), mesh_.F(fa, (ka + 1) % 3), seam, -1, alt,
+                                  seam_length(cut_, seam), rounded, labels, x, density, power);
+  choice.n_faces = a.n_faces;
+  choice.distortion[0] = a.energy[0];
+  choice.distortion[1] = a.energy[1];
   // Lower distortion wins; ties (both failed, or equal) go to the nearest rounding.
   const int nearest = static_cast<int>(std::lround(measure));
   if (choice.distortion[0] < choice.distortion[1])
@@ -129,6 +177,32 @@ PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<i
     choice.matching = lo + 1;
   else
     choice.matching = nearest;
+  return choice;
+}
+
+FeatureChoice LocalEstimator::choose_feature(int feature, const std::vector<int>& rounded,
+                                             const std::vector<int>& labels,
+                                             const Eigen::VectorXd& x, Density density,
+                                             double power) const {
+  FeatureChoice choice;
+  const int h = features_->halfedge[feature];
+  std::array<std::vector<SparseRow>, 2> alt;
+  for (int c = 0; c < 2; ++c) alt[c].push_back(feature_row(cut_, h, c));
+  const int v0 = mesh_.F(h / 3, h % 3), v1 = mesh_.F(h / 3, (h % 3 + 1) % 3);
+  const double len = (mesh_.V.row(v1) - mesh_.V.row(v0)).norm();
+  const Alternatives a =
+      evaluate(v0, v1, -1, feature, alt, len, rounded, labels, x, density, power);
+  choice.n_faces = a.n_faces;
+  for (int c = 0; c < 2; ++c) {
+    choice.distortion[c] = a.energy[c];
+    choice.tau[c] = a.tau[c];
+  }
+  if (choice.distortion[0] < choice.distortion[1])
+    choice.label = 0;
+  else if (choice.distortion[1] < choice.distortion[0])
+    choice.label = 1;
+  else
+    choice.label = nearest_label(feature_measure(cut_, x, h));
   return choice;
 }
 

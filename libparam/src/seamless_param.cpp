@@ -3,6 +3,7 @@
 #include "cone_pairs.h"
 #include "constraint_elimination.h"
 #include "cut_layout.h"
+#include "feature_alignment.h"
 #include "layout_optimizer.h"
 #include "local_estimation.h"
 
@@ -15,12 +16,19 @@
 #include <tbb/task_arena.h>
 #endif
 
+#include <Eigen/Geometry>
+
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <climits>
 #include <functional>
 #include <iterator>
 #include <cmath>
 #include <mutex>
+#include <optional>
+#include <numbers>
+#include <unordered_map>
 #include <stdexcept>
 
 namespace quadify::param {
@@ -50,8 +58,15 @@ struct ComponentOutput {
   Eigen::MatrixX2d corner_uv;
   std::vector<SeamMatching> seams;  // component-local face and vertex ids
   std::vector<ConeInfo> cones;
+  std::vector<FeatureAlignment> features;  // component-local face ids
   ParamStats stats;
 };
+
+// Key of an undirected edge.
+long long edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
+}
 
 void add_timers(const OptimizeTimers& t, ParamStats* s) {
   s->seconds_setup += t.setup;
@@ -72,7 +87,9 @@ double batch_threshold(const ParamOptions& o, int i) {
                                              : 0.5 - o.threshold_step * (i + 1);
 }
 
-ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options) {
+// feature_edges: component-local vertex pairs of feature edges (edges of `mesh`).
+ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options,
+                              const std::vector<std::array<int, 2>>& feature_edges) {
   ComponentOutput out;
   const auto t0 = Clock::now();
   const CutMesh cut = cut_along_dual_tree(mesh, 0);
@@ -81,6 +98,27 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   const Eigen::MatrixX2d x2 = isometric_unfold(mesh, cut);
   Eigen::VectorXd x(n_vars);
   for (int c = 0; c < cut.n_copies(); ++c) x.segment<2>(2 * c) = x2.row(c).transpose();
+  // Features: their half-edges, and the initial rotation of Alg. 4.
+  FeatureSet fs;
+  {
+    std::unordered_map<long long, int> edge_of;
+    for (int e = 0; e < cut.topo.n_edges(); ++e)
+      edge_of[edge_key(cut.topo.edge_vertex(e, 0), cut.topo.edge_vertex(e, 1))] = e;
+    std::vector<int> edges;
+    for (const auto& [a, b] : feature_edges) edges.push_back(edge_of.at(edge_key(a, b)));
+    if (options.align_boundaries)
+      for (int e = 0; e < cut.topo.n_edges(); ++e)
+        if (cut.topo.is_boundary_edge(e)) edges.push_back(e);
+    fs = make_feature_set(cut, edges);
+  }
+  out.stats.n_feature_edges = fs.size();
+  if (fs.size() > 0 && options.feature_global_rotation) {
+    const double angle = feature_rotation_angle(cut, x, fs);
+    const Eigen::Rotation2Dd rot(-angle);
+    for (int c = 0; c < cut.n_copies(); ++c) x.segment<2>(2 * c) = rot * x.segment<2>(2 * c);
+  }
+  std::vector<int> label(fs.size(), kUnlabeled);
+  std::vector<SparseRow> feature_rows;  // rows of the labeled features, in labeling order
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
 
@@ -103,7 +141,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   if (options.energy == Energy::kConformal) density = Density::kMips;
 
-  const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels);
+  const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
   const int n_steps =
       static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
   for (int step = 0; step < n_steps; ++step) {
@@ -121,7 +159,17 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                                                                   : (last || err > eps);
       if (take) batch.push_back(s);
     }
-    if (batch.empty()) continue;
+    std::vector<int> fbatch;  // features labeled in this batch
+    std::vector<double> fmeasure(fs.size(), 0);
+    for (int i = 0; i < fs.size(); ++i) {
+      if (label[i] != kUnlabeled) continue;
+      fmeasure[i] = feature_measure(cut, x, fs.halfedge[i]);
+      const double err = std::abs(fmeasure[i] - std::round(fmeasure[i]));
+      const bool take = options.order == RoundingOrder::kBottomUp ? (last || err < eps)
+                                                                  : (last || err > eps);
+      if (take) fbatch.push_back(i);
+    }
+    if (batch.empty() && fbatch.empty()) continue;
     // Local estimation of the uncertain ones (patches independent: parallel, deterministic).
     std::vector<int> chosen(batch.size());
     std::vector<int> uncertain;
@@ -137,7 +185,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       std::vector<PatchChoice> choices(uncertain.size());
       auto work = [&](size_t u) {
         const int s = batch[uncertain[u]];
-        choices[u] = estimator.choose(s, m[s], matching, x, density, power);
+        choices[u] = estimator.choose(s, m[s], matching, label, x, density, power);
       };
 #ifdef QUADIFY_WITH_TBB
       tbb::parallel_for(size_t(0), uncertain.size(), work);
@@ -150,6 +198,46 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         chosen[uncertain[u]] = choices[u].matching;
       }
       out.stats.seconds_local_estimation += seconds_since(tl);
+    }
+    // Feature labels: the nearest axis, or local estimation for uncertain ones (a label whose
+    // better patch still exceeds feature_max_tau is disabled); then the wedge check.
+    std::vector<int> proposed = label;
+    std::vector<char> is_new(fs.size(), 0);
+    if (!fbatch.empty()) {
+      std::vector<int> uncertain_features;
+      for (const int i : fbatch) {
+        is_new[i] = 1;
+        proposed[i] = nearest_label(fmeasure[i]);
+        if (options.local_estimation &&
+            std::abs(fmeasure[i] - std::round(fmeasure[i])) >= options.local_estimation_min_error)
+          uncertain_features.push_back(i);
+      }
+      if (!uncertain_features.empty()) {
+        const auto tl = Clock::now();
+        std::vector<FeatureChoice> fchoices(uncertain_features.size());
+        auto work = [&](size_t u) {
+          fchoices[u] =
+              estimator.choose_feature(uncertain_features[u], matching, label, x, density, power);
+        };
+#ifdef QUADIFY_WITH_TBB
+        tbb::parallel_for(size_t(0), uncertain_features.size(), work);
+#else
+        for (size_t u = 0; u < uncertain_features.size(); ++u) work(u);
+#endif
+        for (size_t u = 0; u < uncertain_features.size(); ++u) {
+          const FeatureChoice& fc = fchoices[u];
+          ++out.stats.n_feature_patches;
+          proposed[uncertain_features[u]] =
+              fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
+        }
+        out.stats.seconds_local_estimation += seconds_since(tl);
+      }
+      int n_tau_disabled = 0;
+      for (const int i : fbatch) n_tau_disabled += proposed[i] == kDisabled;
+      const std::vector<int> wc = wedge_conflicts(mesh, cut, x, fs, proposed, is_new);
+      for (const int i : wc) proposed[i] = kDisabled;
+      if (std::getenv("QUADIFY_DEBUG_FEATURES"))
+        std::fprintf(stderr, "batch %d: %zu features, %d tau-disabled, %zu wedge\n", step, fbatch.size(), n_tau_disabled, wc.size());
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
@@ -164,13 +252,91 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       }
       edge_sq += seam_length(cut, s) * seam_length(cut, s);
     }
+    // Feature rows go last, so that a batch whose features cannot be met flip-free can be redone
+    // without them (they are then disabled).
+    std::vector<SparseRow> batch_feature_rows;
+    for (const int i : fbatch)
+      if (proposed[i] == 0 || proposed[i] == 1)
+        batch_feature_rows.push_back(feature_row(cut, fs.halfedge[i], proposed[i]));
+    std::optional<ConstraintEliminator> elim_without_features;
+    if (!batch_feature_rows.empty()) elim_without_features = elim;
+    const size_t n_seam_rows = new_rows.size();
+    const double seam_edge_sq = edge_sq;
+    for (size_t r = 0; r < batch_feature_rows.size(); ++r) {
+      elim.add_row(batch_feature_rows[r]);
+      new_rows.push_back(batch_feature_rows[r]);
+    }
+    for (const int i : fbatch)
+      if (proposed[i] == 0 || proposed[i] == 1) {
+        const int h = fs.halfedge[i];
+        edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3)))
+                       .squaredNorm();
+      }
     out.stats.seconds_elimination += seconds_since(te);
     ++out.stats.n_batches;
+    const Eigen::VectorXd x_before = x;
     TransitionReport tr = move_into_constraints(domain, red, elim, new_rows,
                                                 total_area / edge_sq, &x);
     out.stats.total_iterations += tr.iterations;
     out.stats.n_transition_iterations += tr.iterations;
     add_timers(tr.timers, &out.stats);
+    // A batch whose move fails with its features is redone: first without the features near the
+    // faces that stayed flipped (two vertex rings), then without any of its features.
+    for (int retry = 0; retry < 2 && elim_without_features && (!tr.status.is_ok() || tr.n_flipped > 0);
+         ++retry) {
+      if (std::getenv("QUADIFY_DEBUG_FEATURES"))
+        std::fprintf(stderr, "batch %d failed with features (%d flipped), retry %d\n", step, tr.n_flipped, retry);
+      int n_kept = 0;
+      if (retry == 0) {
+        std::vector<char> near(mesh.n_vertices(), 0);
+        for (int f = 0; f < mesh.n_faces(); ++f) {
+          const auto& fc = domain.face_copies[f];
+          if (core::orient2d(x.segment<2>(2 * fc[0]), x.segment<2>(2 * fc[1]), x.segment<2>(2 * fc[2])) <= 0)
+            for (int k = 0; k < 3; ++k) near[mesh.F(f, k)] = 1;
+        }
+        for (int ring = 0; ring < 2; ++ring) {
+          std::vector<char> grown = near;
+          for (int f = 0; f < mesh.n_faces(); ++f)
+            if (near[mesh.F(f, 0)] || near[mesh.F(f, 1)] || near[mesh.F(f, 2)])
+              grown[mesh.F(f, 0)] = grown[mesh.F(f, 1)] = grown[mesh.F(f, 2)] = 1;
+          near.swap(grown);
+        }
+        for (const int i : fbatch) {
+          if (proposed[i] != 0 && proposed[i] != 1) continue;
+          const int h = fs.halfedge[i];
+          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)])
+            proposed[i] = kDisabled;
+          else
+            ++n_kept;
+        }
+      }
+      if (retry == 1 || n_kept == static_cast<int>(batch_feature_rows.size())) {
+        for (const int i : fbatch)
+          if (proposed[i] == 0 || proposed[i] == 1) proposed[i] = kDisabled;
+        n_kept = 0;
+      }
+      elim = *elim_without_features;
+      new_rows.resize(n_seam_rows);
+      x = x_before;
+      batch_feature_rows.clear();
+      edge_sq = seam_edge_sq;
+      for (const int i : fbatch)
+        if (proposed[i] == 0 || proposed[i] == 1) {
+          batch_feature_rows.push_back(feature_row(cut, fs.halfedge[i], proposed[i]));
+          elim.add_row(batch_feature_rows.back());
+          new_rows.push_back(batch_feature_rows.back());
+          const int h = fs.halfedge[i];
+          edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3)))
+                         .squaredNorm();
+        }
+      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300), &x);
+      out.stats.total_iterations += tr.iterations;
+      out.stats.n_transition_iterations += tr.iterations;
+      add_timers(tr.timers, &out.stats);
+      if (n_kept == 0) break;
+    }
+    for (const int i : fbatch) label[i] = proposed[i];
+    feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
     red_problem.reset();
     red = std::move(tr.reduction);
     red_problem = std::make_unique<LayoutProblem>(domain, red);
@@ -220,6 +386,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       for (int s = 0; s < n_seams; ++s)
         if (!changed[s])
           for (const SparseRow& row : seam_constraint_rows(cut, s, matching[s])) kept.add_row(row);
+      for (const SparseRow& row : feature_rows) kept.add_row(row);
       const Reduction kept_red = kept.reduction(x);
       ConstraintEliminator full = kept;
       std::vector<SparseRow> new_rows;
@@ -311,6 +478,19 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       out.stats.seam_residual = std::max(out.stats.seam_residual, std::abs(v));
     }
   }
+  // Aligned features.
+  for (int i = 0; i < fs.size(); ++i) {
+    if (label[i] == kDisabled) ++out.stats.n_disabled_features;
+    if (label[i] != 0 && label[i] != 1) continue;
+    const int h = fs.halfedge[i];
+    out.features.push_back({h / 3, h % 3, label[i]});
+    const Eigen::Vector2d a = out.corner_uv.row(h), b = out.corner_uv.row(3 * (h / 3) + (h % 3 + 1) % 3);
+    const double len = (b - a).norm();
+    out.stats.feature_alignment_error =
+        std::max(out.stats.feature_alignment_error,
+                 len > 0 ? std::abs(b[label[i]] - a[label[i]]) / len : 0.0);
+  }
+  out.stats.n_aligned_features = static_cast<int>(out.features.size());
   // Flips (exact) and τ.
   double s1max = 0, s2min = std::numeric_limits<double>::infinity();
   for (int f = 0; f < nf; ++f) {
@@ -401,6 +581,25 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     sm.V.resize(sub_vertices[c].size(), 3);
     for (size_t i = 0; i < sub_vertices[c].size(); ++i) sm.V.row(i) = mesh.V.row(sub_vertices[c][i]);
   }
+  // Feature edges per component, in local vertex ids.
+  std::vector<std::vector<std::array<int, 2>>> sub_features(n_comp);
+  if (!options.feature_edges.empty()) {
+    std::unordered_map<long long, int> edge_of;
+    for (int e = 0; e < topo.n_edges(); ++e)
+      edge_of[edge_key(topo.edge_vertex(e, 0), topo.edge_vertex(e, 1))] = e;
+    for (const auto& [a, b] : options.feature_edges) {
+      const auto it = (a >= 0 && b >= 0 && a < mesh.n_vertices() && b < mesh.n_vertices())
+                          ? edge_of.find(edge_key(a, b))
+                          : edge_of.end();
+      if (it == edge_of.end()) {
+        result.status = core::Status::invalid_input("feature edge (" + std::to_string(a) + ", " +
+                                                    std::to_string(b) + ") is not an edge of the mesh");
+        return result;
+      }
+      const int c = component[topo.edge_halfedge[it->second] / 3];
+      sub_features[c].push_back({local_vertex[a], local_vertex[b]});
+    }
+  }
   std::vector<ComponentOutput> outs(n_comp);
   // Components may run on worker threads: serialize the progress callback.
   ParamOptions component_options = options;
@@ -410,7 +609,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
       std::lock_guard<std::mutex> lock(progress_mutex);
       options.progress(stage, step, n_steps);
     };
-  auto work = [&](int c) { outs[c] = run_component(sub[c], component_options); };
+  auto work = [&](int c) { outs[c] = run_component(sub[c], component_options, sub_features[c]); };
 #ifdef QUADIFY_WITH_TBB
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(0, n_comp, work); });
@@ -433,6 +632,13 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
                               sub_vertices[c][s.edge_vertex0], sub_vertices[c][s.edge_vertex1],
                               s.matching});
     for (const ConeInfo& k : o.cones) result.cones.push_back({sub_vertices[c][k.vertex], k.index});
+    for (const FeatureAlignment& fa : o.features)
+      result.features.push_back({sub_faces[c][fa.face], fa.corner, fa.constant_coord});
+    st.n_feature_edges += o.stats.n_feature_edges;
+    st.n_aligned_features += o.stats.n_aligned_features;
+    st.n_disabled_features += o.stats.n_disabled_features;
+    st.n_feature_patches += o.stats.n_feature_patches;
+    st.feature_alignment_error = std::max(st.feature_alignment_error, o.stats.feature_alignment_error);
     st.n_seam_edges += o.stats.n_seam_edges;
     st.n_cones += o.stats.n_cones;
     st.n_patches += o.stats.n_patches;

@@ -154,25 +154,10 @@ void feature_capture(const core::PolyMesh& quads, const core::TriMesh& reference
   } catch (const std::invalid_argument&) {
     return;  // non-manifold or inconsistently oriented reference: no reliable dihedral angles
   }
-  std::vector<Eigen::Vector3d> normal(reference.n_faces());
-  for (int f = 0; f < reference.n_faces(); ++f) {
-    const Eigen::Vector3d a = reference.V.row(reference.F(f, 0)), b = reference.V.row(reference.F(f, 1)),
-                          c = reference.V.row(reference.F(f, 2));
-    normal[f] = (b - a).cross(c - a);
-  }
-  const double cos_threshold = std::cos(options.feature_angle_deg * std::numbers::pi / 180.0);
   std::vector<std::array<Eigen::Vector3d, 2>> sharp;
-  for (int e = 0; e < topo.n_edges(); ++e) {
-    const int h = topo.edge_halfedge[e], t = topo.twin[h];
-    if (t < 0) continue;
-    const Eigen::Vector3d& n0 = normal[h / 3];
-    const Eigen::Vector3d& n1 = normal[t / 3];
-    const double len = n0.norm() * n1.norm();
-    if (!(len > 0)) continue;
-    if (n0.dot(n1) / len < cos_threshold)
-      sharp.push_back({reference.V.row(topo.edge_vertex(e, 0)).transpose(),
-                       reference.V.row(topo.edge_vertex(e, 1)).transpose()});
-  }
+  for (const int e : core::sharp_edges(reference, topo, options.feature_angle_deg))
+    sharp.push_back({reference.V.row(topo.edge_vertex(e, 0)).transpose(),
+                     reference.V.row(topo.edge_vertex(e, 1)).transpose()});
   if (sharp.empty()) return;
 
   // Quad-mesh edges (unique, non-degenerate) in a segment tree.

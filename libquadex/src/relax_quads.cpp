@@ -8,6 +8,7 @@
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
+#include <CGAL/AABB_segment_primitive.h>
 #include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -26,6 +27,12 @@ using Triangle = Kernel::Triangle_3;
 using TriangleIterator = std::vector<Triangle>::const_iterator;
 using TriangleTree =
     CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_triangle_primitive<Kernel, TriangleIterator>>>;
+using Segment = Kernel::Segment_3;
+using SegmentIterator = std::vector<Segment>::const_iterator;
+using SegmentTree =
+    CGAL::AABB_tree<CGAL::AABB_traits<Kernel, CGAL::AABB_segment_primitive<Kernel, SegmentIterator>>>;
+// Quad vertices closer than this (× bounding-box diagonal) to a feature edge are on it.
+constexpr double kOnFeature = 1e-9;
 
 // Fraction of the way to the neighbour centroid tried after the full step is refused.
 constexpr double kHalfStep = 0.5;
@@ -87,6 +94,27 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   for (int v = 0; v < nv; ++v)
     if (vertex_quads[v].empty()) fixed[v] = 1;
+  if (!options.feature_edges.empty()) {
+    std::vector<Segment> segments;
+    for (const auto& [a, b] : options.feature_edges) {
+      if (a < 0 || b < 0 || a >= surface.n_vertices() || b >= surface.n_vertices()) {
+        res.status = core::Status::invalid_input("relax: feature edge vertex out of range");
+        return res;
+      }
+      const Eigen::Vector3d pa = surface.V.row(a), pb = surface.V.row(b);
+      if (pa != pb) segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
+    }
+    if (!segments.empty()) {
+      SegmentTree features(segments.begin(), segments.end());
+      features.accelerate_distance_queries();
+      const double diag = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
+      const double tol2 = (kOnFeature * diag) * (kOnFeature * diag);
+      for (int v = 0; v < nv; ++v)
+        if (!fixed[v] &&
+            features.squared_distance(Point(quads.V(v, 0), quads.V(v, 1), quads.V(v, 2))) <= tol2)
+          fixed[v] = 1;
+    }
+  }
 
   core::PolyMesh& q = res.quads;
   auto count_bad = [&](double threshold) {

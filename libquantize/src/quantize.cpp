@@ -562,6 +562,40 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   for (size_t si = 0; si < cl.seams.size(); ++si)
     for (int d = 0; d < 2; ++d)
       candidates.push_back({{{n_copy_vars + 2 * static_cast<int>(si) + d, 1.0}}, false});
+  // Aligned features (param::FeatureAlignment): the constant coordinate of both ends is an
+  // integer candidate, and the alignment rows are eliminated with the seams.
+  std::vector<param::AffineRow> feature_rows;
+  const size_t n_base_candidates = candidates.size();
+  {
+    std::vector<char> is_candidate(n_copy_vars, 0);
+    for (const Candidate& c : candidates)
+      if (c.is_cone) is_candidate[c.form[0].first] = 1;
+    for (const param::FeatureAlignment& fa : seamless.features) {
+      if (fa.face < 0 || fa.face >= nf || fa.corner < 0 || fa.corner > 2 || fa.constant_coord < 0 ||
+          fa.constant_coord > 1) {
+        out.status = core::Status::invalid_input("feature alignment on face " + std::to_string(fa.face) +
+                                                 " is out of range");
+        return out;
+      }
+      const int a = cl.corner_copy[3 * fa.face + fa.corner];
+      const int b = cl.corner_copy[3 * fa.face + (fa.corner + 1) % 3];
+      const int c = fa.constant_coord;
+      const double scale_ref = std::max({1.0, std::abs(cl.x[2 * a + c]), std::abs(cl.x[2 * b + c])});
+      if (std::abs(cl.x[2 * b + c] - cl.x[2 * a + c]) > options.input_seam_tol * scale_ref * 1e3) {
+        out.status = core::Status::invalid_input("feature edge on face " + std::to_string(fa.face) +
+                                                 " is not aligned with its axis in the input map");
+        return out;
+      }
+      param::AffineRow row;
+      row.entries = {{2 * a + c, -1.0}, {2 * b + c, 1.0}};
+      feature_rows.push_back(row);
+      for (const int k : {a, b})
+        if (!is_candidate[2 * k + c]) {
+          is_candidate[2 * k + c] = 1;
+          candidates.push_back({{{2 * k + c, 1.0}}, false, k, c});
+        }
+    }
+  }
   st.n_candidates = static_cast<int>(candidates.size());
 
   // Scale.
@@ -585,6 +619,14 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   lopt.energy = options.energy;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
+  std::vector<char> feature_coords;
+  if (!feature_rows.empty()) {
+    feature_coords.assign(n_copy_vars, 0);
+    for (const Candidate& c : candidates)
+      if (!c.is_cone && c.copy >= 0) feature_coords[2 * c.copy + c.coord] = 1;
+  }
+  const std::vector<Candidate> base_candidates(candidates.begin(),
+                                               candidates.begin() + n_base_candidates);
   const Clock::time_point deadline =
       options.time_budget_seconds > 0
           ? t0 + std::chrono::duration_cast<Clock::duration>(
@@ -603,9 +645,20 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   for (int r = 1; r <= options.max_scale_retries; ++r)
     scales.push_back(scale * std::pow(options.scale_growth, r));
-  for (int attempt = 0; attempt < static_cast<int>(scales.size()); ++attempt) {
+  // With aligned features, the target scale and its two nearest jitters keep them; if those
+  // dead-end (feature curves closer than the grid allows), the features are dropped and every
+  // scale is tried again without them.
+  std::vector<std::pair<double, bool>> attempts;
+  if (!feature_rows.empty())
+    for (size_t i = 0; i < std::min<size_t>(3, scales.size()); ++i) attempts.push_back({scales[i], true});
+  for (const double sc : scales) attempts.push_back({sc, false});
+  for (int attempt = 0; attempt < static_cast<int>(attempts.size()); ++attempt) {
     st.n_scale_retries = attempt;
-    scale = scales[attempt];
+    scale = attempts[attempt].first;
+    const bool with_features = attempts[attempt].second;
+    lopt.extra_rows = with_features ? feature_rows : std::vector<param::AffineRow>{};
+    lopt.prefer_free_coords = with_features ? feature_coords : std::vector<char>{};
+    const std::vector<Candidate>& attempt_candidates = with_features ? candidates : base_candidates;
     // Scaled copies, each component translated so that its gauge copy is at the origin.
     Eigen::VectorXd x(n_copy_vars);
     for (int k = 0; k < cl.n_copies(); ++k)
@@ -613,8 +666,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
           scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
     lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
     char label[32];
-    std::snprintf(label, sizeof label, "x%.3f", scale / scales[0]);
-    Rounder rounder(mesh, cl, candidates, is_cone_copy, options, &st, deadline, label);
+    std::snprintf(label, sizeof label, "x%.3f%s", scale / scales[0], with_features ? "" : feature_rows.empty() ? "" : " no-features");
+    Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st, deadline, label);
     const Rounder::Outcome outcome = rounder.run(x, lopt);
     st.n_integer_dofs = rounder.n_integer_columns();
     if (outcome == Rounder::Outcome::kFailed) {
@@ -628,7 +681,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                     "x%.3f of the target (attempt %d of %zu, %d of %d integer unknowns rounded); "
                     "a larger --time-budget, a larger --target-faces (fewer cone collisions) or "
                     "a larger --cone-pair-distance may help",
-                    options.time_budget_seconds, scale / scales[0], attempt + 1, scales.size(),
+                    options.time_budget_seconds, scale / scales[0], attempt + 1, attempts.size(),
                     rounder.n_pinned(), rounder.n_integer_columns());
       failure = core::Status::not_converged(msg);
       break;
@@ -646,6 +699,10 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       return out;
     }
     st.scale = scale;
+    st.features_dropped = !feature_rows.empty() && !with_features;
+    st.n_aligned_features = with_features ? static_cast<int>(feature_rows.size()) : 0;
+    if (!with_features) candidates.resize(n_base_candidates);
+    st.n_candidates = static_cast<int>(candidates.size());
     st.n_rounded = st.n_candidates;
     best = xe;
     break;
@@ -654,7 +711,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     out.status = failure.is_ok()
                      ? core::Status::not_converged(
                            "no flip-free integer-seamless map within " +
-                           std::to_string(scales.size()) + " scales" +
+                           std::to_string(attempts.size()) + " attempts" +
                            (last_stuck.empty() ? "" : " (last: " + last_stuck + ")"))
                      : failure;
     st.seconds = seconds_since(t0);
@@ -714,6 +771,40 @@ double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeO
       sum += (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
   const double mean_edge = sum / (3.0 * mesh.n_faces());
   return std::max(quad_edges * target_edge_length(mesh, options), kConePairMeshEdges * mean_edge);
+}
+
+std::vector<std::array<int, 2>> features_for_density(
+    const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& feature_edges,
+    const QuantizeOptions& options, double min_quad_edges) {
+  const int nv = mesh.n_vertices();
+  std::vector<int> parent(nv), degree(nv, 0);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& [a, b] : feature_edges) {
+    if (a < 0 || b < 0 || a >= nv || b >= nv) continue;
+    ++degree[a];
+    ++degree[b];
+    parent[find(a)] = find(b);
+  }
+  std::vector<double> length(nv, 0);
+  std::vector<char> open(nv, 0);
+  for (const auto& [a, b] : feature_edges) {
+    if (a < 0 || b < 0 || a >= nv || b >= nv) continue;
+    const int r = find(a);
+    length[r] += (mesh.V.row(a) - mesh.V.row(b)).norm();
+    if (degree[a] != 2 || degree[b] != 2) open[r] = 1;
+  }
+  const double h = target_edge_length(mesh, options);
+  std::vector<std::array<int, 2>> kept;
+  for (const auto& e : feature_edges) {
+    if (e[0] < 0 || e[1] < 0 || e[0] >= nv || e[1] >= nv) continue;
+    const int r = find(e[0]);
+    if (length[r] >= min_quad_edges * h * (open[r] ? 1 : 4)) kept.push_back(e);
+  }
+  return kept;
 }
 
 QuantizeResult quantize_seamless(const core::TriMesh& mesh, const param::ParamResult& seamless,

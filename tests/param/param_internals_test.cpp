@@ -243,7 +243,7 @@ TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
   const LocalEstimator est(corner, cut, dom, 2);
   const std::vector<int> rounded(cut.seams.size(), INT_MIN);
   const double ambiguous = truth > 0 ? 0.5 : -0.5;
-  const PatchChoice pc = est.choose(0, ambiguous, rounded, x, Density::kSymmetricDirichlet, 1);
+  const PatchChoice pc = est.choose(0, ambiguous, rounded, {}, x, Density::kSymmetricDirichlet, 1);
   EXPECT_EQ(pc.matching, std::lround(truth))
       << "distortions floor " << pc.distortion[0] << " ceil " << pc.distortion[1];
   EXPECT_LT(std::min(pc.distortion[0], pc.distortion[1]), 4 * 1.5 + 1e-9);

@@ -18,6 +18,7 @@ struct ParamArgs {
   std::string input;
   std::string output;
   param::ParamOptions options;
+  FeatureArgs features;
 };
 
 const std::map<std::string, param::RoundingOrder> kOrders = {
@@ -32,6 +33,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
 
   param::ParamOptions options = args.options;
   options.threads = common.threads;
+  const FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &options);
   options.progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
   };
@@ -58,6 +60,9 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                 "%.2f s\n",
                 m.tau, m.n_flipped, m.n_cones, m.n_seam_edges, m.seam_residual_abs, s.n_patches, s.n_improved,
                 s.seconds_total);
+    if (s.n_feature_edges > 0)
+      std::printf("features: %d edges, %d aligned, %d disabled\n", s.n_feature_edges, s.n_aligned_features,
+                  s.n_disabled_features);
   }
   if (!result.status.is_ok())
     std::fprintf(stderr, "quadify: warning: %s: %s\n", args.input.c_str(), result.status.message().c_str());
@@ -87,6 +92,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"tau", number(s.tau)},
                      {"sd_max", number(s.sd_max)},
                      {"seam_residual", number(s.seam_residual)},
+                     {"features", feature_json(feature_input, s)},
                      {"seconds_cut", s.seconds_cut},
                      {"seconds_optimize", s.seconds_optimize},
                      {"seconds_local_estimation", s.seconds_local_estimation},
@@ -162,6 +168,7 @@ CommandRunner register_param(CLI::App& app) {
   app.add_option("--cone-pair-hops", o.cone_pair_max_hops, "Seam edges of a cone-pair cancellation path")
       ->check(CLI::Range(1, 10))
       ->capture_default_str();
+  add_feature_options(app, &args->features);
   return [args](const CommonOptions& common) { return run_param(*args, common); };
 }
 

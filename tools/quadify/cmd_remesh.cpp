@@ -31,6 +31,7 @@ struct RemeshArgs {
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
   double time_budget = 0;         // seconds for the quantization, 0 = none
+  FeatureArgs features;
 };
 
 
@@ -56,6 +57,20 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
   param_options.threads = common.threads;
   param_options.progress = on_progress;
+  FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &param_options);
+  // Boundaries as explicit feature edges, so that curves too small for the density (tiny holes,
+  // short creases) can be left unaligned.
+  if (param_options.align_boundaries) {
+    const core::EdgeTopology topo = core::build_edge_topology(mesh);
+    for (int e = 0; e < topo.n_edges(); ++e)
+      if (topo.is_boundary_edge(e)) param_options.feature_edges.push_back({topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)});
+    param_options.align_boundaries = false;
+  }
+  {
+    const size_t before = param_options.feature_edges.size();
+    param_options.feature_edges = quantize::features_for_density(mesh, param_options.feature_edges, quantize_options);
+    feature_input.n_too_small = static_cast<int>(before - param_options.feature_edges.size());
+  }
   progress.begin("param");
   const param::ParamResult seamless = param::compute_seamless_param(mesh, param_options);
   progress.end();
@@ -84,7 +99,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   quadex::RelaxStats relax_stats;
   if (args.relax) {
     progress.begin("relax");
-    quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh);
+    quadex::RelaxOptions relax_options;
+    relax_options.feature_edges = param_options.feature_edges;
+    quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh, relax_options);
     progress.end();
     if (!relaxed.status.is_ok())
       throw CliError{kExitInternal, args.input + ": quad relaxation failed: " + relaxed.status.to_string()};
@@ -112,12 +129,15 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                      {"patches", ps.n_patches},       {"improved", ps.n_improved},
                      {"cancelled_pairs", ps.n_cancelled_pairs},
                      {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
+                     {"features", feature_json(feature_input, ps)},
                      {"seconds", ps.seconds_total}};
   const quantize::QuantizeStats& qs = integer_map.stats;
   report["quantize"] = {{"scale", qs.scale},          {"target_faces", args.target_faces},
                         {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
                         {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
                         {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
+                        {"aligned_features", qs.n_aligned_features},
+                        {"features_dropped", qs.features_dropped},
                         {"clustered_cones", qs.n_clustered_cones},
                         {"cone_collisions", qs.n_cone_collisions},
                         {"newton_iterations", qs.n_iterations},
@@ -153,7 +173,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"angle_dev_mean", number(m.angle_dev_mean)},
                        {"hausdorff_sym", number(m.hausdorff_sym)},
                        {"mean_dist_sym", number(m.mean_dist_sym)},
-                       {"feature_capture", m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json()}};
+                       {"feature_capture", m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json()},
+                       {"feature_hausdorff", m.feature_capture >= 0 ? number(m.feature_hausdorff) : nlohmann::json()}};
     if (!common.quiet)
       std::printf("%s -> %s: %d faces (%d not quads), %d irregular vertices, %d flipped, Hausdorff %.3g of the "
                   "diagonal\n",
@@ -212,6 +233,7 @@ CommandRunner register_remesh(CLI::App& app) {
   app.add_option("--samples", args->samples, "Area samples per surface for the Hausdorff distance")
       ->check(CLI::Range(1000, 10'000'000))
       ->capture_default_str();
+  add_feature_options(app, &args->features);
   return [args](const CommonOptions& common) { return run_remesh(*args, common); };
 }
 

@@ -5,6 +5,9 @@
 #include <libcore/status.h>
 
 #include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <unordered_set>
 #include <iomanip>
 #include <map>
 
@@ -75,6 +78,128 @@ LoadedMesh load_and_repair(const std::filesystem::path& path, Progress& progress
   if (!loaded.repaired.status.is_ok())
     throw CliError{kExitBadInput, path.string() + ": " + loaded.repaired.status.message()};
   return loaded;
+}
+
+void add_feature_options(CLI::App& app, FeatureArgs* a) {
+  app.add_option("--feature-angle", a->angle_deg,
+                 "Sharp edges (dihedral angle above this, degrees) become chains of quad edges; 0 = no "
+                 "detected features")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 180.0));
+  app.add_option("--feature-edges", a->edge_file,
+                 "Extra feature edges: a text file with one pair 'a b' of 0-based input vertex ids per "
+                 "line ('#' starts a comment)")
+      ->type_name("FILE");
+  app.add_flag("!--no-obj-features", a->from_obj_lines,
+               "Ignore the input OBJ's 'l' lines (by default they are feature edges)");
+  app.add_flag("!--no-boundary-alignment", a->boundaries,
+               "Do not align boundaries with quad edges (by default they are features, so open meshes "
+               "get quads along their boundaries)");
+  app.add_option("--feature-max-tau", a->max_tau,
+                 "Disable a feature whose locally estimated distortion tau stays above this")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+}
+
+namespace {
+long long edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
+}
+}  // namespace
+
+FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
+                                const LoadedMesh& loaded, param::ParamOptions* options) {
+  FeatureInput fi;
+  const core::TriMesh& mesh = loaded.repaired.mesh;
+  const core::EdgeTopology topo = core::build_edge_topology(mesh);
+  options->align_boundaries = args.boundaries;
+  options->feature_max_tau = args.max_tau;
+  options->feature_edges.clear();
+  if (args.angle_deg > 0)
+    for (const int e : core::sharp_edges(mesh, topo, args.angle_deg))
+      options->feature_edges.push_back({topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)});
+  fi.n_detected = static_cast<int>(options->feature_edges.size());
+  // Given edges in input vertex ids, with where they came from.
+  struct Given {
+    int a, b;
+    std::string where;
+  };
+  std::vector<Given> given;
+  if (args.from_obj_lines)
+    for (size_t i = 0; i < loaded.raw.lines.size(); ++i)
+      given.push_back({loaded.raw.lines[i][0], loaded.raw.lines[i][1],
+                       input + ": line segment " + std::to_string(i + 1)});
+  if (!args.edge_file.empty()) {
+    std::ifstream in(args.edge_file);
+    if (!in) throw CliError{kExitBadInput, args.edge_file + ": cannot read the feature edge file"};
+    std::string line;
+    for (int ln = 1; std::getline(in, line); ++ln) {
+      if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+      std::istringstream ls(line);
+      long long a = 0, b = 0;
+      if (!(ls >> a)) continue;  // empty or comment line
+      std::string rest;
+      if (!(ls >> b) || (ls >> rest))
+        throw CliError{kExitBadInput, args.edge_file + ": line " + std::to_string(ln) +
+                                          ": expected two vertex ids 'a b'"};
+      const std::string where = args.edge_file + ": line " + std::to_string(ln);
+      if (a < 0 || b < 0 || a >= loaded.raw.n_vertices() || b >= loaded.raw.n_vertices())
+        throw CliError{kExitBadInput, where + ": vertex id out of range (the input has " +
+                                          std::to_string(loaded.raw.n_vertices()) + " vertices)"};
+      given.push_back({static_cast<int>(a), static_cast<int>(b), where});
+    }
+  }
+  fi.n_given = static_cast<int>(given.size());
+  if (given.empty()) return fi;
+  std::unordered_set<long long> raw_edges;
+  for (int f = 0; f < loaded.raw.n_faces(); ++f)
+    for (int k = 0; k < loaded.raw.degree(f); ++k)
+      raw_edges.insert(edge_key(loaded.raw.vertex(f, k), loaded.raw.vertex(f, (k + 1) % loaded.raw.degree(f))));
+  std::unordered_set<long long> out_edges;
+  for (int e = 0; e < topo.n_edges(); ++e) out_edges.insert(edge_key(topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)));
+  // Input vertex → repaired vertices (several after a split; a welded one maps to its survivor,
+  // the nearest repaired vertex).
+  std::vector<std::vector<int>> outputs(loaded.raw.n_vertices());
+  for (size_t v = 0; v < loaded.repaired.vertex_origin.size(); ++v)
+    outputs[loaded.repaired.vertex_origin[v]].push_back(static_cast<int>(v));
+  auto outputs_of = [&](int a) -> const std::vector<int>& {
+    if (outputs[a].empty() && mesh.n_vertices() > 0) {
+      Eigen::Index best = 0;
+      (mesh.V.rowwise() - loaded.raw.V.row(a)).rowwise().squaredNorm().minCoeff(&best);
+      outputs[a].push_back(static_cast<int>(best));
+    }
+    return outputs[a];
+  };
+  for (const Given& g : given) {
+    if (g.a == g.b || !raw_edges.count(edge_key(g.a, g.b)))
+      throw CliError{kExitBadInput, g.where + ": (" + std::to_string(g.a) + ", " + std::to_string(g.b) +
+                                        ") is not an edge of " + input};
+    bool found = false;
+    for (const int oa : outputs_of(g.a))
+      for (const int ob : outputs_of(g.b))
+        if (oa != ob && out_edges.count(edge_key(oa, ob))) {
+          options->feature_edges.push_back({oa, ob});
+          found = true;
+        }
+    if (!found) ++fi.n_lost;
+  }
+  if (fi.n_lost > 0)
+    std::fprintf(stderr, "quadify: warning: %s: %d feature edges were removed by the repair\n",
+                 input.c_str(), fi.n_lost);
+  return fi;
+}
+
+nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
+  return {{"detected_sharp_edges", fi.n_detected},
+          {"given_edges", fi.n_given},
+          {"given_edges_lost_in_repair", fi.n_lost},
+          {"too_small_for_density", fi.n_too_small},
+          {"feature_edges", s.n_feature_edges},
+          {"aligned", s.n_aligned_features},
+          {"disabled", s.n_disabled_features},
+          {"patches", s.n_feature_patches},
+          {"alignment_error", number(s.feature_alignment_error)}};
 }
 
 nlohmann::json to_json(const core::RepairReport& r) {

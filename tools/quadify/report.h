@@ -6,6 +6,7 @@
 #include <libcore/topology.h>
 #include <libparam/seamless_param.h>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <atomic>
@@ -80,6 +81,28 @@ struct LoadedMesh {
   core::RepairResult repaired;
 };
 LoadedMesh load_and_repair(const std::filesystem::path& path, Progress& progress);
+
+// Feature alignment options shared by `param` and the remesher.
+struct FeatureArgs {
+  double angle_deg = 40;     // --feature-angle: sharp edges above this dihedral angle; 0 = none
+  std::string edge_file;     // --feature-edges FILE: lines "a b" of input vertex ids (0-based)
+  bool from_obj_lines = true;  // OBJ `l` lines of the input are feature edges too
+  bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
+  double max_tau = 2.5;      // --feature-max-tau
+};
+void add_feature_options(CLI::App& app, FeatureArgs* args);
+// Sets options->feature_edges (detected sharp edges, the file's and the OBJ's feature lines,
+// mapped onto the repaired mesh), align_boundaries and feature_max_tau. Throws CliError naming
+// the file for an unreadable edge file or an edge that is not an edge of the input.
+struct FeatureInput {
+  int n_detected = 0;  // sharp edges found by the dihedral angle
+  int n_given = 0;     // edges from the file and the OBJ lines
+  int n_lost = 0;      // given edges that the repair removed (e.g. with a degenerate face)
+  int n_too_small = 0;  // edges of curves too short for the quad density (remesh only)
+};
+FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
+                                const LoadedMesh& loaded, param::ParamOptions* options);
+nlohmann::json feature_json(const FeatureInput& input, const param::ParamStats& stats);
 
 nlohmann::json to_json(const core::RepairReport& report);
 nlohmann::json to_json(const core::TopologyStats& stats);

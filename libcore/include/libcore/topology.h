@@ -39,6 +39,11 @@ EdgeTopology build_edge_topology(const TriMesh& mesh);
 // Face component ids (#F, 0-based, through shared edges); returns the number of components.
 int face_components(const TriMesh& mesh, const EdgeTopology& topo, std::vector<int>* component);
 
+// Sharp edges: interior edges whose dihedral angle (between the two face normals) exceeds
+// angle_deg degrees, as EdgeTopology edge ids in increasing order. Degenerate faces make no
+// sharp edge (their normal is undefined).
+std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, double angle_deg);
+
 // Topological statistics of any triangle mesh (also non-manifold ones: counts only).
 TopologyStats topology_stats(const TriMesh& mesh);
 

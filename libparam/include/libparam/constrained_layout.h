@@ -131,6 +131,14 @@ struct PinnedLayoutOptions {
   std::vector<int> gauge_copies;
   // Per copy (#copies, or empty): keep its coordinates as free variables where possible.
   std::vector<char> prefer_free;
+  // Per copy variable (2·#copies, or empty): pivot on it only when no other variable of a row has
+  // a unit coefficient (coordinates that will be pinned to integers, e.g. of aligned features,
+  // then stay integer combinations of free ones).
+  std::vector<char> prefer_free_coords;
+  // Further homogeneous rows Σ coef·x_var = 0 over copy variables (2·copy + d), e.g. feature
+  // alignment x_b[c] − x_a[c] = 0, eliminated after the seam rows (dependent ones are dropped).
+  // The start x0 must satisfy them.
+  std::vector<AffineRow> extra_rows;
 };
 
 // Outcome of PinnedLayout::pin: targets that were reached flip-free are pinned; the others stay

@@ -7,6 +7,7 @@
 #include <libcore/mesh.h>
 #include <libcore/status.h>
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -52,6 +53,24 @@ struct ParamOptions {
   // points of a grid coarser than their distance. 0 = off (the paper's method).
   double cone_pair_distance = 0;
   int cone_pair_max_hops = 3;
+  // Feature alignment (paper section 6, Alg. 2): each of these mesh edges (pairs of vertex ids,
+  // in either order) is made parallel to the u or the v axis of its chart, labeled together with
+  // the matchings in the same batches (a label is rounded like a matching: the edge's angle to the
+  // u axis in quarter turns, Def. 6.1), so that quantization can put it on an integer iso-line.
+  // A pair that is not an edge of the mesh is an error (kInvalidInput). Boundary edges may be
+  // listed; see also align_boundaries.
+  std::vector<std::array<int, 2>> feature_edges;
+  // Treat every boundary edge as a feature edge (boundary-aligned maps: open meshes then give
+  // pure-quad boundaries).
+  bool align_boundaries = false;
+  // Labels of features with alignment error ≥ local_estimation_min_error are chosen by local
+  // estimation (the patch laid out with the edge along u and along v); a feature whose better
+  // patch layout still has τ above this is disabled (paper 8.4: 2.5). Features whose labels would
+  // close a wedge between two features at a vertex (both along one direction) are disabled too.
+  double feature_max_tau = 2.5;
+  // Rotate the initial layout so that the largest group of feature directions lies along the u
+  // axis (Alg. 4, k-means of the feature edge directions on the unit circle).
+  bool feature_global_rotation = true;
   // TBB worker threads for components, local-estimation patches and per-face energy evaluation;
   // 0 = all hardware threads. The result does not depend on this number. (CHOLMOD's own
   // OpenMP/BLAS threads are not governed by it.)
@@ -70,6 +89,12 @@ struct ParamStats {
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
+  int n_feature_edges = 0;     // feature edges asked for (listed, plus boundaries if aligned)
+  int n_aligned_features = 0;  // feature edges aligned in the result (see ParamResult::features)
+  int n_disabled_features = 0; // feature edges whose alignment was disabled (τ bound, wedge
+                               // conflicts, or a batch that could not be made flip-free)
+  int n_feature_patches = 0;   // local-estimation patches laid out for feature labels
+  double feature_alignment_error = 0;  // max |Δ constant coordinate| / |edge| over aligned ones
   int total_iterations = 0;    // Newton iterations over all optimizations (global layout)
   int n_flipped = 0;           // faces with non-positive UV orientation (exact predicate)
   int n_free_variables = 0;    // reduced variables after all constraints (summed over components)
@@ -105,11 +130,21 @@ struct ConeInfo {
   int index = 0;
 };
 
+// An aligned feature edge: the half-edge of `face` from corner k to corner (k+1)%3 keeps UV
+// coordinate `constant_coord` (0: u, 1: v) constant, i.e. it runs along the other axis. The other
+// side of an interior feature edge is aligned too (through its seam's matching).
+struct FeatureAlignment {
+  int face = -1;
+  int corner = 0;
+  int constant_coord = 0;
+};
+
 struct ParamResult {
   core::Status status;
   core::UVMesh uv;                 // the input mesh with (#F·3)×2 corner UVs
   std::vector<SeamMatching> seams;
   std::vector<ConeInfo> cones;
+  std::vector<FeatureAlignment> features;
   ParamStats stats;
 };
 

@@ -9,6 +9,9 @@
 #include <libcore/mesh.h>
 #include <libcore/status.h>
 
+#include <array>
+#include <vector>
+
 namespace quadify::quadex {
 
 struct RelaxOptions {
@@ -20,6 +23,9 @@ struct RelaxOptions {
   int max_rounds = 20;
   // Vertex rings around the bad quads' vertices that may move too (room to spread the fix).
   int rings = 1;
+  // Feature edges of the surface (vertex-id pairs): quad vertices on them (within 1e-9 of the
+  // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains.
+  std::vector<std::array<int, 2>> feature_edges;
 };
 
 struct RelaxStats {

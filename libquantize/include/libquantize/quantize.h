@@ -7,7 +7,9 @@
 #include <libcore/status.h>
 #include <libparam/seamless_param.h>
 
+#include <array>
 #include <functional>
+#include <vector>
 #include <string>
 
 namespace quadify::quantize {
@@ -50,13 +52,19 @@ struct QuantizeOptions {
 struct QuantizeStats {
   double scale = 0;         // final factor from the input UVs to the integer map's UVs
   int n_scale_retries = 0;  // restarts at another scale (near ones first, then refinements)
-  int n_candidates = 0;     // integer quantities: cone-copy coordinates and seam translations
+  int n_candidates = 0;     // integer quantities: cone-copy coordinates, seam translations and
+                            // the constant coordinates of aligned feature ends
   int n_integer_dofs = 0;   // of those, independent ones (after exact elimination)
   int n_rounded = 0;        // candidates made integer (all of them on success)
   int n_reverted = 0;       // batch splits and roundings to the other neighbouring integer
   int n_batches = 0;        // constrained re-optimizations that succeeded
   int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
   int n_cones = 0;
+  // Aligned features of the input map kept on integer iso-lines (param::FeatureAlignment); when
+  // the rounding dead-ends with them at the target scale and its nearest jitters, they are
+  // dropped (features_dropped) and the map is quantized without them.
+  int n_aligned_features = 0;
+  bool features_dropped = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
   int n_iterations = 0;       // Newton iterations (one factorization each) in total
@@ -86,6 +94,14 @@ struct QuantizeResult {
                                                     const QuantizeOptions& options,
                                                     double quad_edges = 4);
 inline constexpr int kRecommendedConePairHops = 6;
+
+// The feature edges (vertex-id pairs of `mesh`) that quantization at `options`' density can keep
+// on integer iso-lines: a feature curve (a connected component of the feature edges) shorter
+// than min_quad_edges target quad edges, or a closed one shorter than four times that, is dropped
+// (it cannot hold distinct grid points; e.g. a tiny hole's boundary or a short crease of a scan).
+[[nodiscard]] std::vector<std::array<int, 2>> features_for_density(
+    const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& feature_edges,
+    const QuantizeOptions& options, double min_quad_edges = 1);
 
 // Quantizes `seamless` (a result of param::compute_seamless_param for `mesh`, or any map with
 // seams listed with their matchings and every cone in seamless.cones) into an integer-seamless

@@ -1,0 +1,184 @@
+#include "feature_alignment.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace quadify::param {
+namespace {
+
+// k-means iterations of Alg. 4 (four groups on the unit circle converge in a few).
+constexpr int kRotationIterations = 20;
+// Two features at a vertex whose target directions are closer than this (radians) would be laid
+// along one direction: their wedge closes.
+constexpr double kMinWedge = std::numbers::pi / 4;
+
+int next_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 1) % 3; }
+int prev_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 2) % 3; }
+
+Eigen::Vector2d copy_uv(const CutMesh& cut, const Eigen::VectorXd& x, int corner) {
+  return x.segment<2>(2 * cut.corner_copy[corner]);
+}
+
+Eigen::Vector2d edge_vector(const CutMesh& cut, const Eigen::VectorXd& x, int halfedge) {
+  return copy_uv(cut, x, next_in_face(halfedge)) - copy_uv(cut, x, halfedge);
+}
+
+}  // namespace
+
+FeatureSet make_feature_set(const CutMesh& cut, const std::vector<int>& edges) {
+  FeatureSet fs;
+  fs.edge_feature.assign(cut.topo.n_edges(), -1);
+  std::vector<int> sorted = edges;
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  for (const int e : sorted) {
+    fs.edge_feature[e] = fs.size();
+    fs.halfedge.push_back(cut.topo.edge_halfedge[e]);
+  }
+  return fs;
+}
+
+double feature_measure(const CutMesh& cut, const Eigen::VectorXd& x, int halfedge) {
+  const Eigen::Vector2d e = edge_vector(cut, x, halfedge);
+  double q = std::atan2(e.y(), e.x()) / (std::numbers::pi / 2);
+  if (q <= -2) q += 4;
+  return q;
+}
+
+SparseRow feature_row(const CutMesh& cut, int halfedge, int constant_coord) {
+  const int a = cut.corner_copy[halfedge], b = cut.corner_copy[next_in_face(halfedge)];
+  SparseRow row;
+  const int va = 2 * a + constant_coord, vb = 2 * b + constant_coord;
+  if (va < vb)
+    row.entries = {{va, -1.0}, {vb, 1.0}};
+  else
+    row.entries = {{vb, 1.0}, {va, -1.0}};
+  return row;
+}
+
+double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, const FeatureSet& fs) {
+  std::vector<Eigen::Vector2d> dir;
+  std::vector<double> weight;
+  Eigen::Vector2d fourfold = Eigen::Vector2d::Zero();
+  for (const int h : fs.halfedge) {
+    const Eigen::Vector2d e = edge_vector(cut, x, h);
+    const double len = e.norm();
+    if (!(len > 0)) continue;
+    dir.push_back(e / len);
+    weight.push_back(len);
+    const double a = 4 * std::atan2(e.y(), e.x());
+    fourfold += len * Eigen::Vector2d(std::cos(a), std::sin(a));
+  }
+  if (dir.empty()) return 0;
+  const double phi = std::atan2(fourfold.y(), fourfold.x()) / 4;
+  std::array<Eigen::Vector2d, 4> center;
+  for (int k = 0; k < 4; ++k)
+    center[k] = {std::cos(phi + k * std::numbers::pi / 2), std::sin(phi + k * std::numbers::pi / 2)};
+  std::vector<int> group(dir.size(), 0);
+  std::array<double, 4> mass{};
+  for (int it = 0; it < kRotationIterations; ++it) {
+    std::array<Eigen::Vector2d, 4> sum;
+    for (auto& s : sum) s.setZero();
+    mass.fill(0);
+    for (size_t i = 0; i < dir.size(); ++i) {
+      int best = 0;
+      for (int k = 1; k < 4; ++k)
+        if (dir[i].dot(center[k]) > dir[i].dot(center[best])) best = k;
+      group[i] = best;
+      sum[best] += weight[i] * dir[i];
+      mass[best] += weight[i];
+    }
+    for (int k = 0; k < 4; ++k)
+      if (sum[k].norm() > 0) center[k] = sum[k].normalized();
+  }
+  const int largest = static_cast<int>(std::max_element(mass.begin(), mass.end()) - mass.begin());
+  return std::atan2(center[largest].y(), center[largest].x());
+}
+
+std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
+                                 const Eigen::VectorXd& x, const FeatureSet& fs,
+                                 const std::vector<int>& label, const std::vector<char>& is_new) {
+  const auto& topo = cut.topo;
+  const int nv = mesh.n_vertices();
+  std::vector<char> check(nv, 0);
+  for (int i = 0; i < fs.size(); ++i)
+    if (is_new[i] && (label[i] == 0 || label[i] == 1)) {
+      const int h = fs.halfedge[i];
+      check[mesh.F(h / 3, h % 3)] = check[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+    }
+  // A corner per vertex to start from: on a boundary, the corner whose outgoing half-edge is a
+  // boundary half-edge (the first of its fan in counter-clockwise order).
+  std::vector<int> start(nv, -1);
+  for (int c = 0; c < 3 * mesh.n_faces(); ++c) {
+    const int v = mesh.F(c / 3, c % 3);
+    if (check[v] && (start[v] < 0 || topo.twin[c] < 0)) start[v] = c;
+  }
+  std::vector<int> lab = label;
+  std::vector<double> delta(fs.size(), 0);
+  for (int i = 0; i < fs.size(); ++i) {
+    const double q = feature_measure(cut, x, fs.halfedge[i]);
+    delta[i] = (std::round(q) - q) * (std::numbers::pi / 2);
+  }
+  std::vector<int> disabled;
+  struct Entry {
+    double angle;  // unwrapped, from the fan's first outgoing edge
+    int feature;
+  };
+  for (int v = 0; v < nv; ++v) {
+    if (start[v] < 0) continue;
+    std::vector<Entry> fan;
+    double total = 0;
+    bool closed = false;
+    int c = start[v];
+    for (int guard = 0; guard < 3 * mesh.n_faces(); ++guard) {
+      const Eigen::Vector2d p = copy_uv(cut, x, c);
+      const Eigen::Vector2d d_out = copy_uv(cut, x, next_in_face(c)) - p;
+      const Eigen::Vector2d d_in = copy_uv(cut, x, prev_in_face(c)) - p;
+      fan.push_back({total, fs.edge_feature[topo.face_edge(c / 3, c % 3)]});
+      total += std::atan2(d_out.x() * d_in.y() - d_out.y() * d_in.x(), d_out.dot(d_in));
+      const int next = topo.twin[prev_in_face(c)];
+      if (next < 0) {
+        fan.push_back({total, fs.edge_feature[topo.face_edge(c / 3, (c % 3 + 2) % 3)]});
+        break;
+      }
+      if (next == start[v]) {
+        closed = true;
+        break;
+      }
+      c = next;
+    }
+    for (bool changed = true; changed;) {
+      changed = false;
+      std::vector<Entry> on;
+      for (const Entry& e : fan)
+        if (e.feature >= 0 && (lab[e.feature] == 0 || lab[e.feature] == 1)) on.push_back(e);
+      if (on.size() < 2) break;
+      const size_t n_pairs = closed ? on.size() : on.size() - 1;
+      for (size_t j = 0; j < n_pairs && !changed; ++j) {
+        const Entry& a = on[j];
+        const Entry& b = on[(j + 1) % on.size()];
+        const double target_a = a.angle + delta[a.feature];
+        const double target_b = b.angle + (j + 1 == on.size() ? total : 0) + delta[b.feature];
+        if (target_b - target_a >= kMinWedge) continue;
+        int victim = -1;
+        if (is_new[a.feature] && is_new[b.feature])
+          victim = std::abs(delta[a.feature]) >= std::abs(delta[b.feature]) ? a.feature : b.feature;
+        else if (is_new[a.feature])
+          victim = a.feature;
+        else if (is_new[b.feature])
+          victim = b.feature;
+        if (victim < 0 || a.feature == b.feature) continue;
+        lab[victim] = kDisabled;
+        disabled.push_back(victim);
+        changed = true;
+      }
+    }
+  }
+  std::sort(disabled.begin(), disabled.end());
+  disabled.erase(std::unique(disabled.begin(), disabled.end()), disabled.end());
+  return disabled;
+}
+
+}  // namespace quadify::param

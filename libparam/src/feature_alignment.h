@@ -1,0 +1,56 @@
+// Feature alignment (paper section 6): which half-edges carry the alignment rows, how far a
+// feature edge is from an axis (Def. 6.1), the optimal initial rotation (Alg. 4), and the wedge
+// check that keeps two features at a vertex from being labeled into one direction. Internal to
+// libparam.
+#pragma once
+
+#include "cut_layout.h"
+
+#include <libcore/mesh.h>
+
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace quadify::param {
+
+// Label of a feature edge: the UV coordinate it keeps constant (0: u, 1: v), or one of these.
+constexpr int kUnlabeled = -1;
+constexpr int kDisabled = 2;
+
+struct FeatureSet {
+  std::vector<int> halfedge;      // per feature: the half-edge 3f+k whose copies carry its row
+  std::vector<int> edge_feature;  // per EdgeTopology edge: feature index or -1
+  int size() const { return static_cast<int>(halfedge.size()); }
+};
+
+// Features of the edges `edges` (EdgeTopology ids of cut.topo; duplicates ignored), each on the
+// half-edge stored in cut.topo.edge_halfedge.
+FeatureSet make_feature_set(const CutMesh& cut, const std::vector<int>& edges);
+
+// Angle of the feature's edge vector (x: 2·#copies) to the u axis, in quarter turns, (−2, 2].
+double feature_measure(const CutMesh& cut, const Eigen::VectorXd& x, int halfedge);
+
+// The label nearest to a measure: an even number of quarter turns runs along u (v constant).
+inline int nearest_label(double measure) {
+  const long n = std::lround(measure);
+  return (n % 2 == 0) ? 1 : 0;
+}
+
+// The alignment row x_b[c] − x_a[c] = 0 of a half-edge a→b keeping coordinate c constant.
+SparseRow feature_row(const CutMesh& cut, int halfedge, int constant_coord);
+
+// Alg. 4: the angle (radians) of the mean of the largest of four k-means groups of the features'
+// unit edge vectors (length-weighted; deterministic start from the 4-fold circular mean).
+double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, const FeatureSet& fs);
+
+// Wedge check around every vertex touched by a feature of `is_new`: going around the vertex
+// through its faces in the layout x, each labeled feature edge (label 0/1, old or new) will turn
+// by its rounding δ to its axis; two consecutive ones whose target directions are less than
+// 45° apart would close the faces between them (both along one direction). Returns the new
+// features to disable, one per such pair (the one farther from its axis), until no pair remains.
+std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
+                                 const Eigen::VectorXd& x, const FeatureSet& fs,
+                                 const std::vector<int>& label, const std::vector<char>& is_new);
+
+}  // namespace quadify::param
