@@ -32,6 +32,41 @@ def cube():
     return v, f
 
 
+def box(size=(1.0, 0.75, 0.5), cell=0.125):
+    """Closed box, each side a grid of squares of `cell`, each split into two triangles along
+    alternating diagonals: 12 sharp edges of 90 degrees and 8 corners."""
+    index = {}
+    v, f = [], []
+
+    def vid(p):
+        key = tuple(round(c / cell) for c in p)
+        if key not in index:
+            index[key] = len(v)
+            v.append(tuple(k * cell for k in key))
+        return index[key]
+
+    n = [round(s / cell) for s in size]
+    for axis in range(3):
+        a, b = (axis + 1) % 3, (axis + 2) % 3
+        for side in (0, 1):
+            for i in range(n[a]):
+                for j in range(n[b]):
+                    def pt(di, dj):
+                        p = [0.0, 0.0, 0.0]
+                        p[axis] = side * size[axis]
+                        p[a] = (i + di) * cell
+                        p[b] = (j + dj) * cell
+                        return vid(p)
+                    q = [pt(0, 0), pt(1, 0), pt(1, 1), pt(0, 1)]
+                    if side == 0:
+                        q = q[::-1]
+                    if (i + j) % 2 == 0:
+                        f += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
+                    else:
+                        f += [(q[0], q[1], q[3]), (q[1], q[2], q[3])]
+    return v, f
+
+
 def icosphere(levels):
     t = (1 + math.sqrt(5)) / 2
     v = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t),
@@ -96,6 +131,7 @@ def torus(n=20, m=20, R=1.0, r=0.35):
 if __name__ == "__main__":
     write_obj("tet.obj", *tet(), "regular tetrahedron, genus 0")
     write_obj("cube.obj", *cube(), "unit cube, 12 triangles, genus 0")
+    write_obj("box.obj", *box(), "box 1 x 0.75 x 0.5 of 0.125 squares, 416 triangles, 12 sharp edges")
     write_obj("sphere.obj", *icosphere(3), "icosphere level 3, 1280 triangles, genus 0")
     write_obj("disk.obj", *disk(), "open disk, 198 triangles, 1 boundary loop")
     write_obj("torus.obj", *torus(), "torus 20x20, 800 triangles, genus 1")

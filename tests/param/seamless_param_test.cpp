@@ -239,5 +239,96 @@ TEST(SeamlessParam, ProgressAndLocalEstimationCounters) {
   EXPECT_EQ(r2.stats.n_patches, 0);
 }
 
+// Feature alignment (paper section 6): every feature half-edge keeps its labeled coordinate, and
+// the other side of an interior feature edge is aligned through its seam.
+double feature_misalignment(const core::TriMesh& mesh, const ParamResult& r) {
+  double worst = 0;
+  const auto& uv = r.uv.corner_uv;
+  for (const FeatureAlignment& fa : r.features) {
+    const int a = 3 * fa.face + fa.corner, b = 3 * fa.face + (fa.corner + 1) % 3;
+    worst = std::max(worst, std::abs(uv(b, fa.constant_coord) - uv(a, fa.constant_coord)) /
+                                (uv.row(b) - uv.row(a)).norm());
+  }
+  (void)mesh;
+  return worst;
+}
+
+std::vector<std::array<int, 2>> sharp_edge_pairs(const core::TriMesh& mesh, double angle) {
+  const core::EdgeTopology topo = core::build_edge_topology(mesh);
+  std::vector<std::array<int, 2>> pairs;
+  for (const int e : core::sharp_edges(mesh, topo, angle))
+    pairs.push_back({topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)});
+  return pairs;
+}
+
+TEST(FeatureAlignment, BoxEdgesAreAlignedAndCornersAreCones) {
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("box.obj")));
+  ParamOptions o = fast_options();
+  o.feature_edges = sharp_edge_pairs(mesh, 40);
+  ASSERT_EQ(o.feature_edges.size(), 72u) << "12 box edges of 8, 6 and 4 segments";
+  const ParamResult r = compute_seamless_param(mesh, o);
+  const Checked c = check_result("box", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8);
+  EXPECT_EQ(r.stats.n_feature_edges, 72);
+  EXPECT_EQ(r.stats.n_aligned_features, 72);
+  EXPECT_EQ(r.stats.n_disabled_features, 0);
+  EXPECT_LT(feature_misalignment(mesh, r), 1e-9);
+  EXPECT_LT(r.stats.feature_alignment_error, 1e-9);
+  // Aligned creases make each side a rectangle: the map is an isometry, the corners +1 cones.
+  EXPECT_LT(r.stats.tau, 1.001);
+  ASSERT_EQ(r.cones.size(), 8u);
+  for (const ConeInfo& k : r.cones) EXPECT_EQ(k.index, 1);
+}
+
+TEST(FeatureAlignment, DiskBoundaryIsAligned) {
+  const core::TriMesh mesh = test::make_disk(8, 24);
+  ParamOptions o = fast_options();
+  o.align_boundaries = true;
+  const ParamResult r = compute_seamless_param(mesh, o);
+  check_result("disk", mesh, r);
+  EXPECT_EQ(r.stats.n_feature_edges, 24);
+  EXPECT_EQ(r.stats.n_aligned_features + r.stats.n_disabled_features, 24);
+  EXPECT_EQ(r.stats.n_disabled_features, 0);
+  EXPECT_LT(feature_misalignment(mesh, r), 1e-9);
+}
+
+TEST(FeatureAlignment, WedgeOfTwoCloseFeaturesKeepsOne) {
+  // Two radial edges of a disk 15° apart cannot both run along one axis, and they cannot turn by
+  // 90° without a large distortion: the wedge check disables one of them, and the map stays
+  // flip-free.
+  const core::TriMesh mesh = test::make_disk(4, 24);
+  const core::EdgeTopology topo = core::build_edge_topology(mesh);
+  // The centre vertex has the highest valence; take two consecutive spokes of it.
+  std::vector<int> valence(mesh.n_vertices(), 0);
+  for (int e = 0; e < topo.n_edges(); ++e) ++valence[topo.edge_vertex(e, 0)], ++valence[topo.edge_vertex(e, 1)];
+  const int centre = static_cast<int>(std::max_element(valence.begin(), valence.end()) - valence.begin());
+  int spoke0 = -1, spoke1 = -1;
+  for (int f = 0; f < mesh.n_faces() && spoke0 < 0; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) == centre) {
+        spoke0 = mesh.F(f, (k + 1) % 3);
+        spoke1 = mesh.F(f, (k + 2) % 3);
+      }
+  ASSERT_GE(spoke0, 0);
+  ParamOptions o = fast_options();
+  o.feature_edges = {{centre, spoke0}, {centre, spoke1}};
+  const ParamResult r = compute_seamless_param(mesh, o);
+  check_result("disk wedge", mesh, r);
+  EXPECT_EQ(r.stats.n_feature_edges, 2);
+  EXPECT_EQ(r.stats.n_aligned_features, 1);
+  EXPECT_EQ(r.stats.n_disabled_features, 1);
+}
+
+TEST(FeatureAlignment, RejectsAPairThatIsNotAnEdge) {
+  const core::TriMesh mesh = test::make_disk(4, 12);
+  ParamOptions o = fast_options();
+  o.feature_edges = {{0, 0}};
+  EXPECT_EQ(compute_seamless_param(mesh, o).status.code(), core::StatusCode::kInvalidInput);
+  o.feature_edges = {{0, mesh.n_vertices()}};
+  const ParamResult r = compute_seamless_param(mesh, o);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput);
+  EXPECT_NE(r.status.message().find("feature edge"), std::string::npos) << r.status.message();
+}
+
 }  // namespace
 }  // namespace quadify::param

@@ -63,6 +63,74 @@ TEST(QuantizeSeamless, CubeIsIntegerSeamlessAndExtracts) {
   expect_valid_quads("cube", load("cube.obj"), 54, false);
 }
 
+// Feature alignment end to end: the box's creases (or a disk's boundary) are aligned by the
+// parametrization; quantization must put them on integer iso-lines exactly, and extraction then
+// has them as chains of quad edges.
+struct FeatureRun {
+  param::ParamResult param;
+  quantize::QuantizeResult quantized;
+  quadex::ExtractResult quads;
+};
+FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundaries) {
+  FeatureRun run;
+  param::ParamOptions po;
+  po.energy = param::Energy::kSymmetricDirichlet;
+  const core::EdgeTopology topo = core::build_edge_topology(mesh);
+  for (const int e : core::sharp_edges(mesh, topo, 40))
+    po.feature_edges.push_back({topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)});
+  po.align_boundaries = boundaries;
+  run.param = param::compute_seamless_param(mesh, po);
+  if (!run.param.status.is_ok()) return run;
+  quantize::QuantizeOptions qo;
+  qo.target_faces = target;
+  run.quantized = quantize::quantize_seamless(mesh, run.param, qo);
+  if (run.quantized.status.is_ok()) run.quads = quadex::extract_quads(run.quantized.uv);
+  return run;
+}
+
+TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
+  const core::TriMesh mesh = load("box.obj");
+  const FeatureRun run = run_with_features(mesh, 200, false);
+  ASSERT_TRUE(run.param.status.is_ok()) << run.param.status.to_string();
+  ASSERT_EQ(run.param.stats.n_aligned_features, 72);
+  ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();
+  EXPECT_FALSE(run.quantized.stats.features_dropped);
+  EXPECT_EQ(run.quantized.stats.n_aligned_features, 72);
+  EXPECT_EQ(test::integer_seamless_violation(run.quantized.uv), "");
+  // Exactly on integer iso-lines.
+  const Eigen::MatrixX2d& uv = run.quantized.uv.corner_uv;
+  for (const param::FeatureAlignment& fa : run.param.features) {
+    const int a = 3 * fa.face + fa.corner, b = 3 * fa.face + (fa.corner + 1) % 3;
+    const double ua = uv(a, fa.constant_coord), ub = uv(b, fa.constant_coord);
+    EXPECT_EQ(ua, ub) << "face " << fa.face;
+    EXPECT_EQ(ua, std::round(ua)) << "face " << fa.face;
+  }
+  ASSERT_TRUE(run.quads.status.is_ok()) << run.quads.status.to_string();
+  const quadex::QuadMetrics qm = quadex::compute_quad_metrics(run.quads.quads, &mesh);
+  EXPECT_EQ(qm.n_non_quads, 0);
+  EXPECT_TRUE(qm.manifold);
+  EXPECT_EQ(qm.n_flipped, 0);
+  EXPECT_EQ(qm.n_irregular, 8) << "one valence-3 vertex per box corner";
+  EXPECT_GE(qm.feature_capture, 0.999);
+  EXPECT_LT(qm.hausdorff_sym, 1e-9) << "quads on the box's flat sides";
+}
+
+TEST(QuantizeSeamless, AlignedDiskBoundaryGivesPureQuads) {
+  const core::TriMesh mesh = load("disk.obj");
+  const FeatureRun run = run_with_features(mesh, 120, true);
+  ASSERT_TRUE(run.param.status.is_ok()) << run.param.status.to_string();
+  ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();
+  EXPECT_FALSE(run.quantized.stats.features_dropped);
+  EXPECT_EQ(test::integer_seamless_violation(run.quantized.uv), "");
+  ASSERT_TRUE(run.quads.status.is_ok()) << run.quads.status.to_string();
+  const quadex::QuadMetrics qm = quadex::compute_quad_metrics(run.quads.quads, &mesh);
+  EXPECT_EQ(qm.n_non_quads, 0) << "an aligned boundary is made of iso-line pieces";
+  EXPECT_TRUE(qm.manifold);
+  EXPECT_EQ(qm.n_boundary_loops, 1);
+  EXPECT_EQ(qm.n_flipped, 0);
+  EXPECT_NEAR(qm.n_faces, 120, 0.15 * 120);
+}
+
 TEST(QuantizeSeamless, EdgeLengthSetsTheScale) {
   const core::TriMesh mesh = load("sphere.obj");
   const param::ParamResult p = param::compute_seamless_param(mesh);

@@ -247,6 +247,49 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   EXPECT_LT(j["hausdorff_sym"].get<double>(), 0.02);
 }
 
+// The box's creases are detected at the default 40° and end up as quad edges; the report says so.
+TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
+  const fs::path out = dir_ / "box_quads.obj";
+  const std::string box = data_path("box.obj").string();
+  std::string args;
+  args.append("'").append(box).append("' -o '").append(out.string());
+  args.append("' --target-faces 200 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["param"]["features"]["detected_sharp_edges"], 72);
+  EXPECT_EQ(report["param"]["features"]["aligned"], 72);
+  EXPECT_EQ(report["quantize"]["features_dropped"], false);
+  EXPECT_GE(report["quads"]["feature_capture"].get<double>(), 0.999);
+  EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+  EXPECT_EQ(report["quads"]["non_quads"], 0);
+}
+
+// A feature-edge file with a malformed line or a pair that is not an edge is bad input, named.
+TEST_F(CliTest, BadFeatureEdgeFileIsBadInputNamingTheLine) {
+  const fs::path out = dir_ / "o.obj";
+  const std::string box = data_path("box.obj").string();
+  auto run_with = [&](const std::string& text) {
+    write_text(dir_ / "edges.txt", text);
+    std::string args;
+    args.append("param '").append(box).append("' -o '").append(out.string());
+    args.append("' --feature-edges '").append((dir_ / "edges.txt").string()).append("'");
+    return quadify(args, dir_);
+  };
+  CliRun r = run_with("# box edge\n0 1\n0 1 2\n");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("edges.txt: line 3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run_with("0 209\n");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("is not an edge"), std::string::npos) << r.err;
+  r = run_with("0 100000\n");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("out of range"), std::string::npos) << r.err;
+  r = run_with("0 1\n");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
 TEST_F(CliTest, RemeshOnBrokenInputWritesNothing) {
   write_text(dir_ / "bad.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n");  // truncated
   const fs::path out = dir_ / "out.glb";
