@@ -1,5 +1,7 @@
 #include "feature_alignment.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -99,7 +101,8 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 
 std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
                                  const Eigen::VectorXd& x, const FeatureSet& fs,
-                                 const std::vector<int>& label, const std::vector<char>& is_new) {
+                                 const std::vector<int>& label, const std::vector<char>& is_new,
+                                 double max_ratio) {
   const auto& topo = cut.topo;
   const int nv = mesh.n_vertices();
   std::vector<char> check(nv, 0);
@@ -123,24 +126,33 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
   }
   std::vector<int> disabled;
   struct Entry {
-    double angle;  // unwrapped, from the fan's first outgoing edge
+    double angle;    // unwrapped, from the fan's first outgoing edge
+    double angle3d;  // the same on the surface
     int feature;
+    int corner = 0;  // position in the fan (corners before it)
+  };
+  auto corner_angle3d = [&](int c) {
+    const Eigen::Vector3d p = mesh.V.row(mesh.F(c / 3, c % 3));
+    const Eigen::Vector3d a = Eigen::Vector3d(mesh.V.row(mesh.F(c / 3, (c % 3 + 1) % 3))) - p;
+    const Eigen::Vector3d b = Eigen::Vector3d(mesh.V.row(mesh.F(c / 3, (c % 3 + 2) % 3))) - p;
+    return std::atan2(a.cross(b).norm(), a.dot(b));
   };
   for (int v = 0; v < nv; ++v) {
     if (start[v] < 0) continue;
     std::vector<Entry> fan;
-    double total = 0;
+    double total = 0, total3d = 0;
     bool closed = false;
     int c = start[v];
     for (int guard = 0; guard < 3 * mesh.n_faces(); ++guard) {
       const Eigen::Vector2d p = copy_uv(cut, x, c);
       const Eigen::Vector2d d_out = copy_uv(cut, x, next_in_face(c)) - p;
       const Eigen::Vector2d d_in = copy_uv(cut, x, prev_in_face(c)) - p;
-      fan.push_back({total, fs.edge_feature[topo.face_edge(c / 3, c % 3)]});
+      fan.push_back({total, total3d, fs.edge_feature[topo.face_edge(c / 3, c % 3)]});
       total += std::atan2(d_out.x() * d_in.y() - d_out.y() * d_in.x(), d_out.dot(d_in));
+      total3d += corner_angle3d(c);
       const int next = topo.twin[prev_in_face(c)];
       if (next < 0) {
-        fan.push_back({total, fs.edge_feature[topo.face_edge(c / 3, (c % 3 + 2) % 3)]});
+        fan.push_back({total, total3d, fs.edge_feature[topo.face_edge(c / 3, (c % 3 + 2) % 3)]});
         break;
       }
       if (next == start[v]) {
@@ -152,16 +164,28 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
     for (bool changed = true; changed;) {
       changed = false;
       std::vector<Entry> on;
-      for (const Entry& e : fan)
-        if (e.feature >= 0 && (lab[e.feature] == 0 || lab[e.feature] == 1)) on.push_back(e);
+      for (size_t i = 0; i < fan.size(); ++i)
+        if (fan[i].feature >= 0 && (lab[fan[i].feature] == 0 || lab[fan[i].feature] == 1)) {
+          on.push_back(fan[i]);
+          on.back().corner = static_cast<int>(i);
+        }
       if (on.size() < 2) break;
       const size_t n_pairs = closed ? on.size() : on.size() - 1;
+      const int n_corners = static_cast<int>(closed ? fan.size() : fan.size() - 1);
       for (size_t j = 0; j < n_pairs && !changed; ++j) {
         const Entry& a = on[j];
         const Entry& b = on[(j + 1) % on.size()];
         const double target_a = a.angle + delta[a.feature];
-        const double target_b = b.angle + (j + 1 == on.size() ? total : 0) + delta[b.feature];
-        if (target_b - target_a >= kMinWedge) continue;
+        const bool wraps = j + 1 == on.size();
+        const double target_b = b.angle + (wraps ? total : 0) + delta[b.feature];
+        const double gap = target_b - target_a;
+        const double quarters = std::max(1.0, std::round(gap / (std::numbers::pi / 2)));
+        const double gap3d = b.angle3d + (wraps ? total3d : 0) - a.angle3d;
+        const double ratio = std::max(quarters * (std::numbers::pi / 2) / gap3d,
+                                      gap3d / (quarters * (std::numbers::pi / 2)));
+        // Each triangle corner of the wedge opens less than 180°.
+        const int corners = b.corner + (wraps ? n_corners : 0) - a.corner;
+        if (gap >= kMinWedge && ratio <= max_ratio && quarters < 2 * corners) continue;
         int victim = -1;
         if (is_new[a.feature] && is_new[b.feature])
           victim = std::abs(delta[a.feature]) >= std::abs(delta[b.feature]) ? a.feature : b.feature;

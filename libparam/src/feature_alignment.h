@@ -49,8 +49,12 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 // by its rounding δ to its axis; two consecutive ones whose target directions are less than
 // 45° apart would close the faces between them (both along one direction). Returns the new
 // features to disable, one per such pair (the one farther from its axis), until no pair remains.
+// A pair whose wedge would open or close by more than max_ratio (its target angle, a multiple of
+// 90°, against its angle on the surface) is a conflict too: it would cost a distortion τ of about
+// that ratio (paper 8.4 disables features above τ 2.5).
 std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
                                  const Eigen::VectorXd& x, const FeatureSet& fs,
-                                 const std::vector<int>& label, const std::vector<char>& is_new);
+                                 const std::vector<int>& label, const std::vector<char>& is_new,
+                                 double max_ratio);
 
 }  // namespace quadify::param

@@ -19,8 +19,6 @@
 #include <Eigen/Geometry>
 
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <climits>
 #include <functional>
 #include <iterator>
@@ -232,12 +230,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         }
         out.stats.seconds_local_estimation += seconds_since(tl);
       }
-      int n_tau_disabled = 0;
-      for (const int i : fbatch) n_tau_disabled += proposed[i] == kDisabled;
-      const std::vector<int> wc = wedge_conflicts(mesh, cut, x, fs, proposed, is_new);
-      for (const int i : wc) proposed[i] = kDisabled;
-      if (std::getenv("QUADIFY_DEBUG_FEATURES"))
-        std::fprintf(stderr, "batch %d: %zu features, %d tau-disabled, %zu wedge\n", step, fbatch.size(), n_tau_disabled, wc.size());
+      for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new, options.feature_max_tau))
+        proposed[i] = kDisabled;
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
@@ -252,26 +246,25 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       }
       edge_sq += seam_length(cut, s) * seam_length(cut, s);
     }
-    // Feature rows go last, so that a batch whose features cannot be met flip-free can be redone
-    // without them (they are then disabled).
-    std::vector<SparseRow> batch_feature_rows;
-    for (const int i : fbatch)
-      if (proposed[i] == 0 || proposed[i] == 1)
-        batch_feature_rows.push_back(feature_row(cut, fs.halfedge[i], proposed[i]));
+    // Feature rows go after the seam rows, so that a batch whose features cannot be met
+    // flip-free can be redone with fewer of them.
     std::optional<ConstraintEliminator> elim_without_features;
-    if (!batch_feature_rows.empty()) elim_without_features = elim;
     const size_t n_seam_rows = new_rows.size();
     const double seam_edge_sq = edge_sq;
-    for (size_t r = 0; r < batch_feature_rows.size(); ++r) {
-      elim.add_row(batch_feature_rows[r]);
-      new_rows.push_back(batch_feature_rows[r]);
-    }
-    for (const int i : fbatch)
-      if (proposed[i] == 0 || proposed[i] == 1) {
+    std::vector<SparseRow> batch_feature_rows;
+    auto add_batch_features = [&] {
+      for (const int i : fbatch) {
+        if (proposed[i] != 0 && proposed[i] != 1) continue;
+        if (!elim_without_features) elim_without_features = elim;
+        batch_feature_rows.push_back(feature_row(cut, fs.halfedge[i], proposed[i]));
+        elim.add_row(batch_feature_rows.back());
+        new_rows.push_back(batch_feature_rows.back());
         const int h = fs.halfedge[i];
         edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3)))
                        .squaredNorm();
       }
+    };
+    add_batch_features();
     out.stats.seconds_elimination += seconds_since(te);
     ++out.stats.n_batches;
     const Eigen::VectorXd x_before = x;
@@ -284,8 +277,6 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // faces that stayed flipped (two vertex rings), then without any of its features.
     for (int retry = 0; retry < 2 && elim_without_features && (!tr.status.is_ok() || tr.n_flipped > 0);
          ++retry) {
-      if (std::getenv("QUADIFY_DEBUG_FEATURES"))
-        std::fprintf(stderr, "batch %d failed with features (%d flipped), retry %d\n", step, tr.n_flipped, retry);
       int n_kept = 0;
       if (retry == 0) {
         std::vector<char> near(mesh.n_vertices(), 0);
@@ -304,15 +295,17 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         for (const int i : fbatch) {
           if (proposed[i] != 0 && proposed[i] != 1) continue;
           const int h = fs.halfedge[i];
+          // Before the last batch they wait for the next one (more matchings fixed, the layout
+          // moved); in the last batch they are disabled.
           if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)])
-            proposed[i] = kDisabled;
+            proposed[i] = last ? kDisabled : kUnlabeled;
           else
             ++n_kept;
         }
       }
       if (retry == 1 || n_kept == static_cast<int>(batch_feature_rows.size())) {
         for (const int i : fbatch)
-          if (proposed[i] == 0 || proposed[i] == 1) proposed[i] = kDisabled;
+          if (proposed[i] == 0 || proposed[i] == 1) proposed[i] = last ? kDisabled : kUnlabeled;
         n_kept = 0;
       }
       elim = *elim_without_features;
@@ -320,15 +313,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       x = x_before;
       batch_feature_rows.clear();
       edge_sq = seam_edge_sq;
-      for (const int i : fbatch)
-        if (proposed[i] == 0 || proposed[i] == 1) {
-          batch_feature_rows.push_back(feature_row(cut, fs.halfedge[i], proposed[i]));
-          elim.add_row(batch_feature_rows.back());
-          new_rows.push_back(batch_feature_rows.back());
-          const int h = fs.halfedge[i];
-          edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3)))
-                         .squaredNorm();
-        }
+      add_batch_features();
       tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300), &x);
       out.stats.total_iterations += tr.iterations;
       out.stats.n_transition_iterations += tr.iterations;
