@@ -74,6 +74,9 @@ constexpr int kFarPenaltyStages = 8;
 constexpr size_t kConeAlternatives = 4;
 // Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
 constexpr double kConePairMeshEdges = 8;
+// Scales tried with the aligned features before they are dropped: only the target (a dead end
+// with features is rarely rescued by a jitter, and each attempt costs a full rounding run).
+constexpr size_t kFeatureScaleTries = 1;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
 constexpr double kFinalTolerance = 1e-7;
@@ -645,12 +648,11 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   for (int r = 1; r <= options.max_scale_retries; ++r)
     scales.push_back(scale * std::pow(options.scale_growth, r));
-  // With aligned features, the target scale and its two nearest jitters keep them; if those
-  // dead-end (feature curves closer than the grid allows), the features are dropped and every
-  // scale is tried again without them.
+  // With aligned features, the target scale keeps them; if it dead-ends (feature curves closer
+  // than the grid allows), the features are dropped and every scale is tried without them.
   std::vector<std::pair<double, bool>> attempts;
   if (!feature_rows.empty())
-    for (size_t i = 0; i < std::min<size_t>(3, scales.size()); ++i) attempts.push_back({scales[i], true});
+    for (size_t i = 0; i < std::min<size_t>(kFeatureScaleTries, scales.size()); ++i) attempts.push_back({scales[i], true});
   for (const double sc : scales) attempts.push_back({sc, false});
   for (int attempt = 0; attempt < static_cast<int>(attempts.size()); ++attempt) {
     st.n_scale_retries = attempt;

@@ -71,17 +71,36 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     param_options.feature_edges = quantize::features_for_density(mesh, param_options.feature_edges, quantize_options);
     feature_input.n_too_small = static_cast<int>(before - param_options.feature_edges.size());
   }
-  progress.begin("param");
-  const param::ParamResult seamless = param::compute_seamless_param(mesh, param_options);
-  progress.end();
-  if (seamless.status.code() == core::StatusCode::kInvalidInput)
-    throw CliError{kExitBadInput, args.input + ": " + seamless.status.message()};
-  if (!seamless.status.is_ok())
-    throw CliError{kExitInternal, args.input + ": seamless parametrization failed: " + seamless.status.to_string()};
-
+  auto parametrize = [&](const param::ParamOptions& options) {
+    progress.begin("param");
+    param::ParamResult result = param::compute_seamless_param(mesh, options);
+    progress.end();
+    if (result.status.code() == core::StatusCode::kInvalidInput)
+      throw CliError{kExitBadInput, args.input + ": " + result.status.message()};
+    if (!result.status.is_ok())
+      throw CliError{kExitInternal, args.input + ": seamless parametrization failed: " + result.status.to_string()};
+    return result;
+  };
+  param::ParamResult seamless = parametrize(param_options);
   progress.begin("quantize");
-  const quantize::QuantizeResult integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
+  quantize::QuantizeResult integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
   progress.end();
+  // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
+  // distortion) is no longer worth its price, so parametrize and quantize again without them.
+  bool features_dropped = false;
+  if (integer_map.status.is_ok() && integer_map.stats.features_dropped) {
+    features_dropped = true;
+    if (!common.quiet)
+      std::fprintf(stderr, "quadify: %s: the aligned features do not fit the quad grid at this density; "
+                           "remeshing without them (a larger --target-faces may keep them)\n",
+                   args.input.c_str());
+    param_options.feature_edges.clear();
+    param_options.align_boundaries = false;
+    seamless = parametrize(param_options);
+    progress.begin("quantize");
+    integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
+    progress.end();
+  }
   if (!integer_map.status.is_ok())
     throw CliError{kExitInternal,
                    args.input + ": quantization failed: " + integer_map.status.to_string() +
@@ -137,7 +156,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
                         {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
                         {"aligned_features", qs.n_aligned_features},
-                        {"features_dropped", qs.features_dropped},
+                        {"features_dropped", features_dropped || qs.features_dropped},
                         {"clustered_cones", qs.n_clustered_cones},
                         {"cone_collisions", qs.n_cone_collisions},
                         {"newton_iterations", qs.n_iterations},

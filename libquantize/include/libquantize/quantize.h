@@ -61,8 +61,8 @@ struct QuantizeStats {
   int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
   int n_cones = 0;
   // Aligned features of the input map kept on integer iso-lines (param::FeatureAlignment); when
-  // the rounding dead-ends with them at the target scale and its nearest jitters, they are
-  // dropped (features_dropped) and the map is quantized without them.
+  // the rounding dead-ends with them at the target scale, they are dropped (features_dropped)
+  // and the map is quantized without them.
   int n_aligned_features = 0;
   bool features_dropped = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
