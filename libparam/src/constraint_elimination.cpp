@@ -1,6 +1,7 @@
 #include "constraint_elimination.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
 namespace quadify::param {
@@ -18,13 +19,16 @@ Eigen::VectorXd Reduction::restrict(const Eigen::VectorXd& x) const {
   return y;
 }
 
-ConstraintEliminator::ConstraintEliminator(int n_vars, std::vector<char> never_pivot)
+ConstraintEliminator::ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
+                                           std::vector<int> pivot_priority)
     : expr_(n_vars),
       dependent_(n_vars, 0),
       never_pivot_(std::move(never_pivot)),
+      pivot_priority_(std::move(pivot_priority)),
       users_(n_vars),
       scratch_(n_vars, 0.0) {
   never_pivot_.resize(n_vars, 0);
+  pivot_priority_.resize(n_vars, 0);
 }
 
 int ConstraintEliminator::max_expression_length() const {
@@ -55,10 +59,14 @@ bool ConstraintEliminator::add_row(const SparseRow& row) {
   }
   if (reduced.empty()) return false;
 
-  // Pivot: unit coefficient, newest variable; else the largest coefficient.
+  // Pivot: among the variables of highest priority, unit coefficient and newest; else the
+  // largest coefficient.
+  int top = INT_MIN;
+  for (const auto& [v, a] : reduced)
+    if (!never_pivot_[v]) top = std::max(top, pivot_priority_[v]);
   int best = -1;
   for (int i = static_cast<int>(reduced.size()) - 1; i >= 0; --i) {
-    if (never_pivot_[reduced[i].first]) continue;
+    if (never_pivot_[reduced[i].first] || pivot_priority_[reduced[i].first] != top) continue;
     if (std::abs(std::abs(reduced[i].second) - 1.0) < kZeroCoefficient) {
       best = i;
       break;

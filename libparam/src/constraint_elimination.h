@@ -29,10 +29,15 @@ struct Reduction {
 // away from the root, so expressions reference older copies); with 0/±1 input coefficients
 // this keeps every α an integer, so x = P·y satisfies the constraints exactly in exact arithmetic.
 // Redundant rows (dependent on earlier ones, e.g. around vertices) are detected and dropped.
+// With pivot priorities, the pivot is a variable of highest priority in the row, chosen among
+// those by the rule above; a non-unit pivot (e.g. 2 = det(I − R²) at a cone) then gives
+// coefficients in ½ℤ, still exact in binary floating point.
 class ConstraintEliminator {
  public:
-  // never_pivot[v]: variable v stays free (the translation gauge).
-  ConstraintEliminator(int n_vars, std::vector<char> never_pivot);
+  // never_pivot[v]: variable v stays free (the translation gauge). pivot_priority[v] (empty: all
+  // equal) ranks the variables a row may be solved for, higher first.
+  ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
+                       std::vector<int> pivot_priority = {});
   // Returns true if the row was independent of the previous ones.
   bool add_row(const SparseRow& row);
   int rank() const { return rank_; }
@@ -47,6 +52,7 @@ class ConstraintEliminator {
   std::vector<Expr> expr_;                           // empty when free
   std::vector<char> dependent_;
   std::vector<char> never_pivot_;
+  std::vector<int> pivot_priority_;
   std::vector<std::vector<int>> users_;              // dependents that may reference a variable
   std::vector<double> scratch_;
   int rank_ = 0;
