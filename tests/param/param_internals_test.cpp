@@ -197,6 +197,40 @@ TEST(SeamBasis, SameSpaceAsCopiesOnlyExactAndLocal) {
   }
 }
 
+// At a cube corner the root face's first vertex is a cone, whose copy the elimination solves for:
+// the gauge moves to a copy of another vertex and the space stays the copies-only one.
+TEST(SeamBasis, GaugeLeavesAConeAtTheRoot) {
+  core::TriMesh corner;
+  corner.V.resize(4, 3);
+  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  corner.F.resize(3, 3);
+  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const CutMesh cut = cut_along_dual_tree(corner, 0);
+  ASSERT_EQ(cut.seams.size(), 1u);
+  ASSERT_EQ(cut.copy_vertex[cut.root_copy], 0);
+  const Eigen::VectorXd x0 = flatten(isometric_unfold(corner, cut));
+  const int r = static_cast<int>(std::lround(measure_matchings(cut, isometric_unfold(corner, cut))[0]));
+  SeamBasisInfo info;
+  const ConstraintEliminator elim = eliminate_seams(cut, {r}, &info);
+  EXPECT_EQ(info.n_closed_vertices, 1);
+  EXPECT_EQ(info.n_cones, 1);
+  EXPECT_NE(cut.copy_vertex[info.gauge_copy], 0) << "the gauge must not sit on the cone";
+  Eigen::VectorXd xb = Eigen::VectorXd::Zero(n_seam_basis_vars(cut));
+  xb.head(x0.size()) = x0;
+  const Reduction red = elim.reduction(xb);
+  std::vector<char> gauge(x0.size(), 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator copies_only(static_cast<int>(x0.size()), gauge);
+  for (const auto& row : seam_constraint_rows(cut, 0, r)) copies_only.add_row(row);
+  EXPECT_EQ(red.n_free(), copies_only.reduction(x0).n_free());
+  const Eigen::VectorXd x = red.expand(Eigen::VectorXd::LinSpaced(red.n_free(), -1.0, 2.0));
+  for (const auto& row : seam_translation_rows(cut, 0, r)) {
+    double v = 0;
+    for (const auto& [var, c] : row.entries) v += c * x[var];
+    EXPECT_LT(std::abs(v), 1e-12) << "end row residual";
+  }
+}
+
 TEST(DistortionEnergy, DerivativesMatchFiniteDifferences) {
   const Eigen::Matrix2d J = (Eigen::Matrix2d() << 1.3, 0.2, -0.4, 0.9).finished();
   const std::pair<Density, double> kinds[] = {{Density::kSymmetricDirichlet, 1},
