@@ -30,7 +30,7 @@ struct Reduction {
 // this keeps every α an integer, so x = P·y satisfies the constraints exactly in exact arithmetic.
 // Redundant rows (dependent on earlier ones, e.g. around vertices) are detected and dropped.
 // With pivot priorities, the pivot is a variable of highest priority in the row, chosen among
-// those by the rule above; a non-unit pivot (e.g. 2 = det(I − R²) at a cone) then gives
+// those by the rule above; a non-unit pivot (e.g. the 2 of I − R² at a cone) then gives
 // coefficients in ½ℤ, still exact in binary floating point.
 class ConstraintEliminator {
  public:

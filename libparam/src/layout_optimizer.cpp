@@ -615,7 +615,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   // the new matchings are close to the measured rotations).
   {
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
+    const Eigen::VectorXd y_new =
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       return rep;
@@ -642,7 +643,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
       if (max_residual(x_cur) > residual_tol) continue;
     }
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
+    const Eigen::VectorXd y_new =
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       break;
@@ -658,7 +660,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   }
   if (best_flips == INT32_MAX) {
     core::Status ps;
-    x_best = rep.reduction.expand(project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection));
+    x_best = rep.reduction.expand(
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection));
     best_flips = count_flipped(domain, x_best);
   }
   rep.n_flipped = best_flips;

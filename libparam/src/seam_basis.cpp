@@ -67,7 +67,8 @@ ConstraintEliminator eliminate_seams(const CutMesh& cut, const std::vector<int>&
     if (!constrained(s)) open[v0] = open[v1] = 1;
   }
   for (int e = 0; e < cut.topo.n_edges(); ++e)
-    if (cut.topo.is_boundary_edge(e)) open[cut.topo.edge_vertex(e, 0)] = open[cut.topo.edge_vertex(e, 1)] = 1;
+    if (cut.topo.is_boundary_edge(e))
+      open[cut.topo.edge_vertex(e, 0)] = open[cut.topo.edge_vertex(e, 1)] = 1;
 
   // Rotation around each closed vertex: walk the cycle of its copies, x_b = R^r x_a + t.
   std::vector<char> cone(nv, 0);

@@ -1,5 +1,6 @@
 // Unit tests of libparam internals: cut + isometric unfold, matching measurement, constraint
-// elimination (copies only and in the seam-translation basis), energy derivatives, the layout optimizer and local estimation.
+// elimination (copies only and in the seam-translation basis), energy derivatives, the layout
+// optimizer and local estimation.
 #include "constraint_elimination.h"
 #include "cut_layout.h"
 #include "distortion_energy.h"
@@ -209,7 +210,8 @@ TEST(SeamBasis, GaugeLeavesAConeAtTheRoot) {
   ASSERT_EQ(cut.seams.size(), 1u);
   ASSERT_EQ(cut.copy_vertex[cut.root_copy], 0);
   const Eigen::VectorXd x0 = flatten(isometric_unfold(corner, cut));
-  const int r = static_cast<int>(std::lround(measure_matchings(cut, isometric_unfold(corner, cut))[0]));
+  const int r =
+      static_cast<int>(std::lround(measure_matchings(cut, isometric_unfold(corner, cut))[0]));
   SeamBasisInfo info;
   const ConstraintEliminator elim = eliminate_seams(cut, {r}, &info);
   EXPECT_EQ(info.n_closed_vertices, 1);
