@@ -664,7 +664,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
     for (int k = 0; k < n; ++k)
       for (int d = 0; d < 2; ++d) pivot_last[2 * copy_slot[k] + d] = options.prefer_free_coords[2 * k + d];
   }
-  ConstraintEliminator elim(n_vars, never_pivot, pivot_last);
+  ConstraintEliminator elim(n_vars, never_pivot, {}, pivot_last);
   for (int si = 0; si < n_seams; ++si) {
     const CopySeam& s = copies.seams[si];
     for (const auto& [a, b] : {std::pair{s.a0, s.b0}, std::pair{s.a1, s.b1}})

@@ -1,6 +1,7 @@
 #include "constraint_elimination.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 
 namespace quadify::param {
@@ -19,14 +20,17 @@ Eigen::VectorXd Reduction::restrict(const Eigen::VectorXd& x) const {
 }
 
 ConstraintEliminator::ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
+                                           std::vector<int> pivot_priority,
                                            std::vector<char> pivot_last)
     : expr_(n_vars),
       dependent_(n_vars, 0),
       never_pivot_(std::move(never_pivot)),
+      pivot_priority_(std::move(pivot_priority)),
       pivot_last_(std::move(pivot_last)),
       users_(n_vars),
       scratch_(n_vars, 0.0) {
   never_pivot_.resize(n_vars, 0);
+  pivot_priority_.resize(n_vars, 0);
   pivot_last_.resize(n_vars, 0);
 }
 
@@ -58,11 +62,14 @@ bool ConstraintEliminator::add_row(const SparseRow& row) {
   }
   if (reduced.empty()) return false;
 
-  // Pivot: unit coefficient, newest variable (pivot_last ones only when no other has a unit
-  // coefficient); else the largest coefficient.
+  // Pivot: among the variables of highest priority, a unit coefficient, newest variable
+  // (pivot_last ones only when no other has a unit coefficient); else the largest coefficient.
+  int top = INT_MIN;
+  for (const auto& [v, a] : reduced)
+    if (!never_pivot_[v]) top = std::max(top, pivot_priority_[v]);
   int best = -1, best_last = -1;
   for (int i = static_cast<int>(reduced.size()) - 1; i >= 0; --i) {
-    if (never_pivot_[reduced[i].first]) continue;
+    if (never_pivot_[reduced[i].first] || pivot_priority_[reduced[i].first] != top) continue;
     if (std::abs(std::abs(reduced[i].second) - 1.0) < kZeroCoefficient) {
       if (!pivot_last_[reduced[i].first]) {
         best = i;

@@ -29,13 +29,18 @@ struct Reduction {
 // away from the root, so expressions reference older copies); with 0/±1 input coefficients
 // this keeps every α an integer, so x = P·y satisfies the constraints exactly in exact arithmetic.
 // Redundant rows (dependent on earlier ones, e.g. around vertices) are detected and dropped.
+// With pivot priorities, the pivot is a variable of highest priority in the row, chosen among
+// those by the rule above; a non-unit pivot (e.g. the 2 of I − R² at a cone) then gives
+// coefficients in ½ℤ, still exact in binary floating point.
 class ConstraintEliminator {
  public:
-  // never_pivot[v]: variable v stays free (the translation gauge). pivot_last[v] (may be empty):
-  // v is pivoted on only when no other variable of the row has a unit coefficient (e.g. variables
-  // that will be pinned to integers, which must stay integer combinations of free ones).
+  // never_pivot[v]: variable v stays free (the translation gauge). pivot_priority[v] (empty: all
+  // equal) ranks the variables a row may be solved for, higher first. pivot_last[v] (empty:
+  // none): among those, v is pivoted on only when no other variable of the row has a unit
+  // coefficient (e.g. variables that will be pinned to integers, which must stay integer
+  // combinations of free ones).
   ConstraintEliminator(int n_vars, std::vector<char> never_pivot,
-                       std::vector<char> pivot_last = {});
+                       std::vector<int> pivot_priority = {}, std::vector<char> pivot_last = {});
   // Returns true if the row was independent of the previous ones.
   bool add_row(const SparseRow& row);
   int rank() const { return rank_; }
@@ -50,6 +55,7 @@ class ConstraintEliminator {
   std::vector<Expr> expr_;                           // empty when free
   std::vector<char> dependent_;
   std::vector<char> never_pivot_;
+  std::vector<int> pivot_priority_;
   std::vector<char> pivot_last_;
   std::vector<std::vector<int>> users_;              // dependents that may reference a variable
   std::vector<double> scratch_;

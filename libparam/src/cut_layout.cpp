@@ -128,16 +128,12 @@ Eigen::MatrixX2d isometric_unfold(const core::TriMesh& mesh, const CutMesh& cut)
   return x;
 }
 
-namespace {
-struct SeamEnds {
-  int a0, a1, b0, b1;  // copies of v0, v1 in face a and in face b
-};
-SeamEnds seam_ends(const CutMesh& cut, const CutSeam& s) {
+SeamEnds seam_ends(const CutMesh& cut, int seam) {
+  const CutSeam& s = cut.seams[seam];
   const int fa = s.he_a / 3, ka = s.he_a % 3, fb = s.he_b / 3, kb = s.he_b % 3;
   return {cut.corner_copy[3 * fa + ka], cut.corner_copy[3 * fa + (ka + 1) % 3],
           cut.corner_copy[3 * fb + (kb + 1) % 3], cut.corner_copy[3 * fb + kb]};
 }
-}  // namespace
 
 double seam_length(const CutMesh& cut, int seam) {
   const int f = cut.seams[seam].he_a / 3, k = cut.seams[seam].he_a % 3;
@@ -150,7 +146,7 @@ double seam_length(const CutMesh& cut, int seam) {
 std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d& x) {
   std::vector<double> m(cut.seams.size());
   for (size_t i = 0; i < cut.seams.size(); ++i) {
-    const SeamEnds c = seam_ends(cut, cut.seams[i]);
+    const SeamEnds c = seam_ends(cut, static_cast<int>(i));
     const Eigen::Vector2d ea = (x.row(c.a1) - x.row(c.a0)).transpose();
     const Eigen::Vector2d eb = (x.row(c.b1) - x.row(c.b0)).transpose();
     m[i] = std::atan2(cross2(ea, eb), ea.dot(eb)) / (0.5 * std::numbers::pi);
@@ -159,7 +155,7 @@ std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d
 }
 
 std::array<SparseRow, 2> seam_constraint_rows(const CutMesh& cut, int seam, int matching) {
-  const SeamEnds c = seam_ends(cut, cut.seams[seam]);
+  const SeamEnds c = seam_ends(cut, seam);
   const int r = ((matching % 4) + 4) % 4;
   // (R^r e)[d] = sign[d] · e[src[d]].
   static constexpr int kSrc[4][2] = {{0, 1}, {1, 0}, {0, 1}, {1, 0}};

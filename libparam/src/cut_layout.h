@@ -44,6 +44,12 @@ CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face = 0);
 // Isometric layout of the cut mesh, face by face in BFS order: (#copies)×2 positions.
 Eigen::MatrixX2d isometric_unfold(const core::TriMesh& mesh, const CutMesh& cut);
 
+// The vertex copies at the ends of seam s: v0 and v1 in face a (a0, a1) and in face b (b0, b1).
+struct SeamEnds {
+  int a0, a1, b0, b1;
+};
+SeamEnds seam_ends(const CutMesh& cut, int seam);
+
 // Continuous matching of each seam, in quarter turns in (−2, 2]: the rotation from
 // e_a = x(v1 in face a) − x(v0 in face a) to e_b = x(v1 in face b) − x(v0 in face b).
 std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d& x);

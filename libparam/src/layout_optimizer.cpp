@@ -130,6 +130,7 @@ struct LayoutProblem::Impl {
   bool analyzed = false;
   double setup_seconds = 0;   // not yet reported by an optimization
   int max_element_variables = 0;
+  long long sum_sq_element_variables = 0;
   // Column → (element, local index) incidences, elements in increasing id within a column
   // (faces 0..#F−1, then the penalty rows).
   std::vector<int> col_start;
@@ -147,8 +148,11 @@ struct LayoutProblem::Impl {
 #else
     for (int f = 0; f < d.n_faces(); ++f) build(f);
 #endif
-    for (const Element& el : faces)
-      max_element_variables = std::max(max_element_variables, static_cast<int>(el.ys.size()));
+    for (const Element& el : faces) {
+      const long long k = static_cast<long long>(el.ys.size());
+      max_element_variables = std::max(max_element_variables, static_cast<int>(k));
+      sum_sq_element_variables += k * k;
+    }
     if (penalty_rows) {
       for (const auto& row : *penalty_rows) {
         std::vector<int> xv;
@@ -453,6 +457,7 @@ OptimizeReport optimize_layout(LayoutProblem& problem, const OptimizeSettings& s
   prob.setup_seconds = 0;
   rep.hessian_nonzeros = prob.dense ? 0 : prob.H.nonZeros();
   rep.max_element_variables = prob.max_element_variables;
+  rep.sum_sq_element_variables = prob.sum_sq_element_variables;
   const int n = red.n_free();
   Eigen::VectorXd x = red.expand(*y);
   Eigen::VectorXd g;
@@ -552,21 +557,22 @@ constexpr double kPenaltyTolerance = 1e-10;
 // seam edge length (the projection then moves vertices by about as much).
 constexpr double kProjectResidual = 1e-3;
 
-// Least-squares y with P·y + c ≈ x.
-Eigen::VectorXd project(const Reduction& red, const Eigen::VectorXd& x, core::Status* status,
-                        double* seconds) {
+// Least-squares y with P·y + c ≈ x on the first n_fitted entries (−1: all).
+Eigen::VectorXd project(const Reduction& red, const Eigen::VectorXd& x, int n_fitted,
+                        core::Status* status, double* seconds) {
   const auto t0 = Clock::now();
   struct AddTime {
     Clock::time_point t0;
     double* s;
     ~AddTime() { *s += seconds_since(t0); }
   } add_time{t0, seconds};
-  const Eigen::SparseMatrix<double> P = red.P;
+  const Eigen::Index rows = n_fitted < 0 ? red.P.rows() : n_fitted;
+  const Eigen::SparseMatrix<double> P = red.P.topRows(rows);
   Eigen::SparseMatrix<double> PtP = P.transpose() * P;
   core::SparseSolver solver;
   *status = solver.factorize(PtP);
   if (!status->is_ok()) return red.restrict(x);
-  return solver.solve(P.transpose() * (x - red.c));
+  return solver.solve(P.transpose() * (x - red.c).head(rows));
 }
 
 }  // namespace
@@ -582,7 +588,7 @@ int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x) {
 TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
                                        const ConstraintEliminator& elim,
                                        const std::vector<SparseRow>& new_rows, double weight_unit,
-                                       Eigen::VectorXd* x) {
+                                       Eigen::VectorXd* x, int n_fitted) {
   TransitionReport rep;
   const auto t_red = Clock::now();
   rep.reduction = elim.reduction(*x);
@@ -609,7 +615,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   // the new matchings are close to the measured rotations).
   {
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps, &rep.timers.projection);
+    const Eigen::VectorXd y_new =
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       return rep;
@@ -636,7 +643,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
       if (max_residual(x_cur) > residual_tol) continue;
     }
     core::Status ps;
-    const Eigen::VectorXd y_new = project(rep.reduction, x_cur, &ps, &rep.timers.projection);
+    const Eigen::VectorXd y_new =
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection);
     if (!ps.is_ok()) {
       rep.status = ps;
       break;
@@ -652,7 +660,8 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   }
   if (best_flips == INT32_MAX) {
     core::Status ps;
-    x_best = rep.reduction.expand(project(rep.reduction, x_cur, &ps, &rep.timers.projection));
+    x_best = rep.reduction.expand(
+        project(rep.reduction, x_cur, n_fitted, &ps, &rep.timers.projection));
     best_flips = count_flipped(domain, x_best);
   }
   rep.n_flipped = best_flips;

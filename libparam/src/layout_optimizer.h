@@ -66,6 +66,7 @@ struct OptimizeReport {
   OptimizeTimers timers;
   long long hessian_nonzeros = 0;   // of the reduced Hessian PᵀHP (sparse mode), both triangles
   int max_element_variables = 0;    // reduced variables of the widest face element
+  long long sum_sq_element_variables = 0;  // Σ_f k_f² over the face elements (setup/assembly work)
   int iterations = 0;
   double energy = 0;            // area-weighted density sum (+ penalty)
   double initial_energy = 0;
@@ -125,11 +126,13 @@ struct TransitionReport {
 // `elim` (old rows + `new_rows`) without flips: minimises SD + w·weight_unit·Σ(row·x)² inside the
 // old space for increasing w until the new rows are nearly satisfied, then projects (least
 // squares) onto the new space and checks orientations exactly; continues with larger w while
-// faces are flipped. weight_unit makes w dimensionless (area / Σ edge length²).
+// faces are flipped. weight_unit makes w dimensionless (area / Σ edge length²). The projections
+// fit the first n_fitted entries of x (−1: all), e.g. the copies when the other variables are
+// functions of them (seam translations).
 TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
                                        const ConstraintEliminator& elim,
                                        const std::vector<SparseRow>& new_rows, double weight_unit,
-                                       Eigen::VectorXd* x);
+                                       Eigen::VectorXd* x, int n_fitted = -1);
 
 // Faces with non-positive orientation of their three copies in x (exact predicate).
 int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x);

@@ -6,6 +6,7 @@
 #include "feature_alignment.h"
 #include "layout_optimizer.h"
 #include "local_estimation.h"
+#include "seam_basis.h"
 
 #include <libcore/predicates.h>
 #include <libcore/sparse_solver.h>
@@ -92,9 +93,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   const auto t0 = Clock::now();
   const CutMesh cut = cut_along_dual_tree(mesh, 0);
   const LayoutDomain domain = make_domain(cut);
-  const int n_vars = 2 * cut.n_copies();
+  // x: the copies' UVs and the seam translations (seam_basis.h); the energy reads the copies.
+  const int n_copy_vars = 2 * cut.n_copies();
   const Eigen::MatrixX2d x2 = isometric_unfold(mesh, cut);
-  Eigen::VectorXd x(n_vars);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n_seam_basis_vars(cut));
   for (int c = 0; c < cut.n_copies(); ++c) x.segment<2>(2 * c) = x2.row(c).transpose();
   // Features: their half-edges, and the initial rotation of Alg. 4.
   FeatureSet fs;
@@ -120,13 +122,12 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
 
-  std::vector<char> gauge(n_vars, 0);
-  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
-  ConstraintEliminator elim(n_vars, gauge);
-  Reduction red = elim.reduction(x);
-  std::unique_ptr<LayoutProblem> red_problem;  // energy structure over red (reset with red)
   const int n_seams = static_cast<int>(cut.seams.size());
   std::vector<int> matching(n_seams, INT_MIN);  // INT_MIN: not rounded yet
+  // Rebuilt for each constraint set: its pivots depend on where the cones are.
+  ConstraintEliminator elim = eliminate_seams(cut, matching);
+  Reduction red = elim.reduction(x);
+  std::unique_ptr<LayoutProblem> red_problem;  // energy structure over red (reset with red)
   double total_area = 0;
   for (double a : cut.area) total_area += a;
 
@@ -240,14 +241,14 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     for (size_t i = 0; i < batch.size(); ++i) {
       const int s = batch[i];
       matching[s] = chosen[i];
-      for (const SparseRow& row : seam_constraint_rows(cut, s, chosen[i])) {
-        elim.add_row(row);
-        new_rows.push_back(row);
-      }
+      for (const SparseRow& row : seam_constraint_rows(cut, s, chosen[i])) new_rows.push_back(row);
       edge_sq += seam_length(cut, s) * seam_length(cut, s);
     }
-    // Feature rows go after the seam rows, so that a batch whose features cannot be met
-    // flip-free can be redone with fewer of them.
+    // The seam basis is rebuilt for the new matchings; the labeled features' rows follow it, and
+    // this batch's features go last, so that a batch whose features cannot be met flip-free can
+    // be redone with fewer of them.
+    elim = eliminate_seams(cut, matching);
+    for (const SparseRow& row : feature_rows) elim.add_row(row);
     std::optional<ConstraintEliminator> elim_without_features;
     const size_t n_seam_rows = new_rows.size();
     const double seam_edge_sq = edge_sq;
@@ -269,7 +270,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     ++out.stats.n_batches;
     const Eigen::VectorXd x_before = x;
     TransitionReport tr = move_into_constraints(domain, red, elim, new_rows,
-                                                total_area / edge_sq, &x);
+                                                total_area / edge_sq, &x, n_copy_vars);
     out.stats.total_iterations += tr.iterations;
     out.stats.n_transition_iterations += tr.iterations;
     add_timers(tr.timers, &out.stats);
@@ -343,6 +344,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     out.stats.max_hessian_nonzeros = std::max(out.stats.max_hessian_nonzeros, rep.hessian_nonzeros);
     out.stats.max_element_variables =
         std::max(out.stats.max_element_variables, rep.max_element_variables);
+    out.stats.max_sum_sq_element_variables =
+        std::max(out.stats.max_sum_sq_element_variables, rep.sum_sq_element_variables);
     if (rep.status.is_ok()) x = red.expand(y);
     out.stats.seconds_optimize += seconds_since(to);
   }
@@ -367,26 +370,25 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
           new_matching[ch.seam] += ch.delta;
           changed[ch.seam] = 1;
         }
-      ConstraintEliminator kept(n_vars, gauge);
+      std::vector<int> kept_matching = matching;
       for (int s = 0; s < n_seams; ++s)
-        if (!changed[s])
-          for (const SparseRow& row : seam_constraint_rows(cut, s, matching[s])) kept.add_row(row);
+        if (changed[s]) kept_matching[s] = INT_MIN;
+      ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
       for (const SparseRow& row : feature_rows) kept.add_row(row);
       const Reduction kept_red = kept.reduction(x);
-      ConstraintEliminator full = kept;
+      Eigen::VectorXd x_try = x;
+      ConstraintEliminator full = eliminate_seams(cut, new_matching);
+      for (const SparseRow& row : feature_rows) full.add_row(row);
       std::vector<SparseRow> new_rows;
       double edge_sq = 0;
       for (int s = 0; s < n_seams; ++s)
         if (changed[s]) {
-          for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s])) {
-            full.add_row(row);
+          for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s]))
             new_rows.push_back(row);
-          }
           edge_sq += seam_length(cut, s) * seam_length(cut, s);
         }
-      Eigen::VectorXd x_try = x;
-      TransitionReport tr =
-          move_into_constraints(domain, kept_red, full, new_rows, total_area / edge_sq, &x_try);
+      TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows,
+                                                  total_area / edge_sq, &x_try, n_copy_vars);
       out.stats.total_iterations += tr.iterations;
       out.stats.n_transition_iterations += tr.iterations;
       add_timers(tr.timers, &out.stats);
@@ -653,6 +655,8 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_tau_iterations += o.stats.n_tau_iterations;
     st.max_hessian_nonzeros = std::max(st.max_hessian_nonzeros, o.stats.max_hessian_nonzeros);
     st.max_element_variables = std::max(st.max_element_variables, o.stats.max_element_variables);
+    st.max_sum_sq_element_variables =
+        std::max(st.max_sum_sq_element_variables, o.stats.max_sum_sq_element_variables);
   }
   const double diag = core::bbox_diagonal(mesh.V);
   if (result.status.is_ok() && st.seam_residual > options.seam_tol * diag)

@@ -88,9 +88,10 @@ double seconds_since(Clock::time_point t0) {
 // An integer candidate: one scalar variable (a cone-copy coordinate or a seam translation).
 struct Candidate {
   std::vector<std::pair<int, double>> form;
-  bool is_cone = false;  // a cone-copy coordinate (else a seam translation)
-  int copy = -1;         // the cone copy
+  bool is_cone = false;  // a cone-copy coordinate (else a seam translation or a feature end)
+  int copy = -1;         // the cone copy, or the copy of a feature end
   int coord = 0;         // its coordinate (0: u, 1: v)
+  bool is_feature = false;  // the constant coordinate of an aligned feature's end: optional
   double value(const Eigen::VectorXd& x) const {
     double v = 0;
     for (const auto& [var, a] : form) v += a * x[var];
@@ -172,6 +173,7 @@ class Rounder {
     stats_->n_iterations += layout_.minimize(opt_.max_newton_iters, kBatchTolerance, &status_);
     if (!status_.is_ok()) return Outcome::kFailed;
     Outcome outcome = round_cones();
+    if (outcome == Outcome::kDone) outcome = round_features();
     if (outcome == Outcome::kDone) outcome = round_others();
     stats_->seconds_rounding += seconds_since(tc);
     if (outcome != Outcome::kDone) return outcome;
@@ -180,9 +182,14 @@ class Rounder {
     stats_->seconds_final += seconds_since(tc);
     if (!status_.is_ok()) return Outcome::kFailed;
     for (const int j : int_cols_)
-      if (!layout_.is_pinned(j)) return Outcome::kStuck;
+      if (!layout_.is_pinned(j) && !released_[j]) return Outcome::kStuck;
     return layout_.n_flipped() == 0 ? Outcome::kDone : Outcome::kStuck;
   }
+
+  // Free columns left unpinned: feature lines that reached no integer (their features are not
+  // on iso-lines; no required candidate depends on them).
+  const std::vector<char>& released() const { return released_; }
+  int n_released() const { return static_cast<int>(std::count(released_.begin(), released_.end(), 1)); }
 
   const param::PinnedLayout& layout() const { return layout_; }
   const core::Status& status() const { return status_; }
@@ -222,6 +229,18 @@ class Rounder {
     }
     for (size_t j = 0; j < red.free_vars.size(); ++j)
       if (is_int_col[j]) int_cols_.push_back(static_cast<int>(j));
+    // Feature columns, and the columns that required (cone and translation) candidates use: a
+    // feature column outside the latter may stay unpinned.
+    released_.assign(red.free_vars.size(), 0);
+    feature_col_.assign(red.free_vars.size(), 0);
+    required_col_.assign(red.free_vars.size(), 0);
+    for (const Candidate& c : cand_) {
+      const int v = c.form[0].first;
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it) {
+        if (c.is_feature && col_of_var[v] == static_cast<int>(it.col())) feature_col_[it.col()] = 1;
+        if (!c.is_feature) required_col_[it.col()] = 1;
+      }
+    }
     for (int k = 0; k < cl_.n_copies(); ++k) {
       if (!is_cone_copy_[k]) continue;
       const int cu = col_of_var[2 * k], cv = col_of_var[2 * k + 1];
@@ -423,12 +442,48 @@ class Rounder {
     return Outcome::kDone;
   }
 
+  // Feature lines (free feature columns no required candidate depends on), in batches by
+  // rounding error like the cones, so that the map can make room between close lines; a line
+  // that reaches neither neighbouring integer (by a penalty homotopy) is released: it stays where
+  // it is, and its features are not on an iso-line.
+  Outcome round_features() {
+    const int n_steps = std::max(1, static_cast<int>(std::ceil(0.5 / opt_.threshold_step - 1e-9)));
+    for (int step = 0; step < n_steps; ++step) {
+      const double eps = opt_.threshold_step * (step + 1);
+      std::vector<std::pair<int, double>> targets;
+      for (const int j : int_cols_) {
+        if (!feature_col_[j] || required_col_[j] || layout_.is_pinned(j) || released_[j]) continue;
+        const double v = layout_.y()[j];
+        if (step + 1 == n_steps || std::abs(v - std::round(v)) < eps) targets.push_back({j, std::round(v)});
+      }
+      if (targets.empty()) continue;
+      if (out_of_time()) return Outcome::kOutOfTime;
+      pin(targets);
+      if (!status_.is_ok()) return Outcome::kFailed;
+      report_progress("features");
+      for (const auto& [j, value] : targets) {
+        if (layout_.is_pinned(j)) continue;
+        const double v = layout_.y()[j];
+        bool placed = false;
+        for (const double alt : {std::round(v), v < std::round(v) ? std::round(v) - 1 : std::round(v) + 1}) {
+          if (out_of_time()) return Outcome::kOutOfTime;
+          ++stats_->n_reverted;
+          pin({{j, alt}}, true);
+          if (!status_.is_ok()) return Outcome::kFailed;
+          if ((placed = layout_.is_pinned(j))) break;
+        }
+        if (!placed) released_[j] = 1;
+      }
+    }
+    return Outcome::kDone;
+  }
+
   // The remaining integer columns (translations and lone cone coordinates) to their nearest
   // integers in one batch; a blocked one then tries its other neighbouring integer.
   Outcome round_others() {
     std::vector<std::pair<int, double>> targets;
     for (const int j : int_cols_)
-      if (!layout_.is_pinned(j)) targets.push_back({j, std::round(layout_.y()[j])});
+      if (!layout_.is_pinned(j) && !released_[j]) targets.push_back({j, std::round(layout_.y()[j])});
     if (targets.empty()) return Outcome::kDone;
     if (out_of_time()) return Outcome::kOutOfTime;
     pin(targets);
@@ -464,6 +519,7 @@ class Rounder {
   param::PinnedLayout layout_;
   core::Status status_;
   std::vector<int> int_cols_;
+  std::vector<char> released_, feature_col_, required_col_;  // per free column
   std::vector<Cone> cones_;
   std::map<GridKey, int> occupied_;  // grid points of pinned cones → their mesh vertex
   int n_pinned_ = 0;
@@ -595,7 +651,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       for (const int k : {a, b})
         if (!is_candidate[2 * k + c]) {
           is_candidate[2 * k + c] = 1;
-          candidates.push_back({{{2 * k + c, 1.0}}, false, k, c});
+          candidates.push_back({{{2 * k + c, 1.0}}, false, k, c, true});
         }
     }
   }
@@ -702,10 +758,9 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     }
     st.scale = scale;
     st.features_dropped = !feature_rows.empty() && !with_features;
-    st.n_aligned_features = with_features ? static_cast<int>(feature_rows.size()) : 0;
+    st.n_released_feature_lines = rounder.n_released();
     if (!with_features) candidates.resize(n_base_candidates);
     st.n_candidates = static_cast<int>(candidates.size());
-    st.n_rounded = st.n_candidates;
     best = xe;
     break;
   }
@@ -721,9 +776,11 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   // Exact verification of Def. 3.2.
   const Eigen::VectorXd& x = *best;
+  st.n_rounded = 0;
   for (size_t i = 0; i < candidates.size(); ++i) {
     const double v = candidates[i].value(x);
-    if (v != std::round(v)) {
+    st.n_rounded += v == std::round(v);
+    if (v != std::round(v) && !candidates[i].is_feature) {
       out.status =
           core::Status::internal("integer quantity " + std::to_string(i) + " is " +
                                  std::to_string(v) + ", not an exact integer after snapping");
@@ -747,6 +804,11 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   for (int c = 0; c < 3 * nf; ++c)
     out.uv.corner_uv.row(c) = x.segment<2>(2 * cl.corner_copy[c]).transpose();
+  if (!st.features_dropped)
+    for (const param::AffineRow& row : feature_rows) {
+      const double v = x[row.entries[0].first];
+      st.n_aligned_features += v == std::round(v) && x[row.entries[1].first] == v;
+    }
   st.n_flipped = count_flipped(cl, x, nf);
   st.uv_area = uv_area(cl, x, nf);
   st.seconds = seconds_since(t0);

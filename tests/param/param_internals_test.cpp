@@ -1,10 +1,12 @@
 // Unit tests of libparam internals: cut + isometric unfold, matching measurement, constraint
-// elimination, energy derivatives, the layout optimizer and local estimation.
+// elimination (copies only and in the seam-translation basis), energy derivatives, the layout
+// optimizer and local estimation.
 #include "constraint_elimination.h"
 #include "cut_layout.h"
 #include "distortion_energy.h"
 #include "layout_optimizer.h"
 #include "local_estimation.h"
+#include "seam_basis.h"
 
 #include <libcore/predicates.h>
 
@@ -13,6 +15,7 @@
 
 #include <climits>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 #include "test_meshes.h"
@@ -111,6 +114,123 @@ TEST(ConstraintElimination, ResidualIsZeroAndRedundantRowsAreDropped) {
   // The gauge copy keeps its position.
   EXPECT_EQ(x[2 * cut.root_copy], x0[2 * cut.root_copy]);
   EXPECT_LE(elim.max_expression_length(), red.n_free());
+}
+
+// Reduced variables of face f's edge vectors x1 − x0, x2 − x0 (what its energy element reads).
+int face_element_variables(const Reduction& red, const CutMesh& cut, int f) {
+  std::vector<int> ys;
+  for (int j = 1; j < 3; ++j)
+    for (int d = 0; d < 2; ++d) {
+      std::map<int, double> acc;
+      using It = Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator;
+      for (It it(red.P, 2 * cut.corner_copy[3 * f + j] + d); it; ++it) acc[it.col()] += it.value();
+      for (It it(red.P, 2 * cut.corner_copy[3 * f] + d); it; ++it) acc[it.col()] -= it.value();
+      for (const auto& [v, a] : acc)
+        if (a != 0) ys.push_back(v);
+    }
+  std::sort(ys.begin(), ys.end());
+  return static_cast<int>(std::unique(ys.begin(), ys.end()) - ys.begin());
+}
+
+// The seam basis spans the same seamless space as the copies-only elimination, exactly (P in ½ℤ),
+// for every seam or for half of them, and keeps face elements small.
+TEST(SeamBasis, SameSpaceAsCopiesOnlyExactAndLocal) {
+  const std::pair<const char*, core::TriMesh> meshes[] = {{"icosphere3", test::make_icosphere(3)},
+                                                          {"torus", test::make_torus(24, 10)},
+                                                          {"disk", test::make_disk(6, 14)}};
+  for (const auto& [name, m] : meshes) {
+    const CutMesh cut = cut_along_dual_tree(m, 0);
+    const Eigen::VectorXd x0 = flatten(isometric_unfold(m, cut));
+    const auto meas = measure_matchings(cut, isometric_unfold(m, cut));
+    const int n_seams = static_cast<int>(cut.seams.size());
+    for (int part = 1; part <= 2; ++part) {
+      std::vector<int> matching(n_seams, INT_MIN);
+      for (int s = 0; s < n_seams; ++s)
+        if (s % part == 0) matching[s] = static_cast<int>(std::lround(meas[s]));
+      std::vector<char> gauge(x0.size(), 0);
+      gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+      ConstraintEliminator copies_only(static_cast<int>(x0.size()), gauge);
+      std::vector<SparseRow> rows;
+      for (int s = 0; s < n_seams; ++s)
+        if (matching[s] != INT_MIN)
+          for (const auto& r : seam_constraint_rows(cut, s, matching[s])) {
+            copies_only.add_row(r);
+            rows.push_back(r);
+          }
+      const Reduction old_red = copies_only.reduction(x0);
+      SeamBasisInfo info;
+      const ConstraintEliminator elim = eliminate_seams(cut, matching, &info);
+      Eigen::VectorXd xb = Eigen::VectorXd::Zero(n_seam_basis_vars(cut));
+      xb.head(x0.size()) = x0;
+      const Reduction red = elim.reduction(xb);
+      EXPECT_EQ(red.n_free(), old_red.n_free()) << name << " part " << part;
+      for (int k = 0; k < red.P.outerSize(); ++k)
+        for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, k); it; ++it)
+          ASSERT_EQ(2 * it.value(), std::round(2 * it.value())) << name << ": P entry not in ½ℤ";
+      const Eigen::VectorXd x = red.expand(Eigen::VectorXd::LinSpaced(red.n_free(), -1.0, 2.0));
+      double worst = 0;
+      for (const auto& r : rows) {
+        double v = 0;
+        for (const auto& [var, c] : r.entries) v += c * x[var];
+        worst = std::max(worst, std::abs(v));
+      }
+      for (int s = 0; s < n_seams; ++s)
+        if (matching[s] != INT_MIN)
+          for (const auto& r : seam_translation_rows(cut, s, matching[s])) {
+            double v = 0;
+            for (const auto& [var, c] : r.entries) v += c * x[var];
+            worst = std::max(worst, std::abs(v));
+          }
+      EXPECT_LT(worst, 1e-12) << name << " part " << part << ": seam residual of P·y + c";
+      EXPECT_EQ(x.segment<2>(2 * info.gauge_copy), x0.segment<2>(2 * info.gauge_copy)) << name;
+      int widest = 0, widest_old = 0;
+      for (int f = 0; f < m.n_faces(); ++f) {
+        widest = std::max(widest, face_element_variables(red, cut, f));
+        widest_old = std::max(widest_old, face_element_variables(old_red, cut, f));
+      }
+      // 3 copies' edge vectors plus the free translations of a few BFS regions.
+      EXPECT_LE(widest, 24) << name << " part " << part << " (copies only: " << widest_old << ")";
+      if (part == 1 && std::string(name) == "icosphere3") {
+        EXPECT_GT(info.n_cones, 8) << "rounded isometric matchings put cones everywhere";
+        EXPECT_LT(widest, widest_old) << "cones: copies-only elements grow";
+      }
+    }
+  }
+}
+
+// At a cube corner the root face's first vertex is a cone, whose copy the elimination solves for:
+// the gauge moves to a copy of another vertex and the space stays the copies-only one.
+TEST(SeamBasis, GaugeLeavesAConeAtTheRoot) {
+  core::TriMesh corner;
+  corner.V.resize(4, 3);
+  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  corner.F.resize(3, 3);
+  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const CutMesh cut = cut_along_dual_tree(corner, 0);
+  ASSERT_EQ(cut.seams.size(), 1u);
+  ASSERT_EQ(cut.copy_vertex[cut.root_copy], 0);
+  const Eigen::VectorXd x0 = flatten(isometric_unfold(corner, cut));
+  const int r =
+      static_cast<int>(std::lround(measure_matchings(cut, isometric_unfold(corner, cut))[0]));
+  SeamBasisInfo info;
+  const ConstraintEliminator elim = eliminate_seams(cut, {r}, &info);
+  EXPECT_EQ(info.n_closed_vertices, 1);
+  EXPECT_EQ(info.n_cones, 1);
+  EXPECT_NE(cut.copy_vertex[info.gauge_copy], 0) << "the gauge must not sit on the cone";
+  Eigen::VectorXd xb = Eigen::VectorXd::Zero(n_seam_basis_vars(cut));
+  xb.head(x0.size()) = x0;
+  const Reduction red = elim.reduction(xb);
+  std::vector<char> gauge(x0.size(), 0);
+  gauge[2 * cut.root_copy] = gauge[2 * cut.root_copy + 1] = 1;
+  ConstraintEliminator copies_only(static_cast<int>(x0.size()), gauge);
+  for (const auto& row : seam_constraint_rows(cut, 0, r)) copies_only.add_row(row);
+  EXPECT_EQ(red.n_free(), copies_only.reduction(x0).n_free());
+  const Eigen::VectorXd x = red.expand(Eigen::VectorXd::LinSpaced(red.n_free(), -1.0, 2.0));
+  for (const auto& row : seam_translation_rows(cut, 0, r)) {
+    double v = 0;
+    for (const auto& [var, c] : row.entries) v += c * x[var];
+    EXPECT_LT(std::abs(v), 1e-12) << "end row residual";
+  }
 }
 
 TEST(DistortionEnergy, DerivativesMatchFiniteDifferences) {

@@ -110,7 +110,8 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                        {"batch_iterations", s.n_batch_iterations},
                        {"tau_iterations", s.n_tau_iterations},
                        {"max_hessian_nonzeros", s.max_hessian_nonzeros},
-                       {"max_element_variables", s.max_element_variables}}}};
+                       {"max_element_variables", s.max_element_variables},
+                       {"max_sum_sq_element_variables", s.max_sum_sq_element_variables}}}};
   report["metrics"] = {{"tau", number(m.tau)},
                        {"flipped", m.n_flipped},
                        {"degenerate", m.n_degenerate},

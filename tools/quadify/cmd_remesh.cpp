@@ -156,6 +156,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
                         {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
                         {"aligned_features", qs.n_aligned_features},
+                        {"released_feature_lines", qs.n_released_feature_lines},
                         {"features_dropped", features_dropped || qs.features_dropped},
                         {"clustered_cones", qs.n_clustered_cones},
                         {"cone_collisions", qs.n_cone_collisions},

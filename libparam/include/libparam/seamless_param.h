@@ -112,6 +112,7 @@ struct ParamStats {
          seconds_factorize = 0, seconds_line_search = 0, seconds_projection = 0, seconds_tau = 0;
   long long max_hessian_nonzeros = 0;  // largest reduced Hessian of the global layout
   int max_element_variables = 0;       // reduced variables of the widest face element
+  long long max_sum_sq_element_variables = 0;  // largest Σ_f k_f² (k_f: a face's reduced variables)
   int n_transition_iterations = 0, n_batch_iterations = 0, n_tau_iterations = 0;
 };
 

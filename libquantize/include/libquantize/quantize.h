@@ -55,15 +55,18 @@ struct QuantizeStats {
   int n_candidates = 0;     // integer quantities: cone-copy coordinates, seam translations and
                             // the constant coordinates of aligned feature ends
   int n_integer_dofs = 0;   // of those, independent ones (after exact elimination)
-  int n_rounded = 0;        // candidates made integer (all of them on success)
+  int n_rounded = 0;        // candidates made integer (all but released feature ends on success)
   int n_reverted = 0;       // batch splits and roundings to the other neighbouring integer
   int n_batches = 0;        // constrained re-optimizations that succeeded
   int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
   int n_cones = 0;
-  // Aligned features of the input map kept on integer iso-lines (param::FeatureAlignment); when
-  // the rounding dead-ends with them at the target scale, they are dropped (features_dropped)
-  // and the map is quantized without them.
+  // Aligned features of the input map (param::FeatureAlignment) that the result has exactly on
+  // integer iso-lines. Feature lines that reach no integer flip-free are released (left where
+  // they are; n_released_feature_lines), unless a cone or translation depends on them; when the
+  // rounding still dead-ends at the target scale, all features are dropped (features_dropped) and
+  // the map is quantized without them.
   int n_aligned_features = 0;
+  int n_released_feature_lines = 0;
   bool features_dropped = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
