@@ -315,7 +315,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       batch_feature_rows.clear();
       edge_sq = seam_edge_sq;
       add_batch_features();
-      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300), &x);
+      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300),
+                                 &x, n_copy_vars);
       out.stats.total_iterations += tr.iterations;
       out.stats.n_transition_iterations += tr.iterations;
       add_timers(tr.timers, &out.stats);
