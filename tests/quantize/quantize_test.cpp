@@ -96,6 +96,8 @@ TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
   ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();
   EXPECT_FALSE(run.quantized.stats.features_dropped);
   EXPECT_EQ(run.quantized.stats.n_aligned_features, 72);
+  EXPECT_EQ(run.quantized.stats.n_released_feature_lines, 0);
+  EXPECT_EQ(run.quantized.stats.n_rounded, run.quantized.stats.n_candidates);
   EXPECT_EQ(test::integer_seamless_violation(run.quantized.uv), "");
   // Exactly on integer iso-lines.
   const Eigen::MatrixX2d& uv = run.quantized.uv.corner_uv;
