@@ -442,6 +442,21 @@ class Rounder {
     return Outcome::kDone;
   }
 
+  // Pins free column j alone at its nearest integer, else at the other neighbouring one (far:
+  // with the penalty homotopy); *placed tells whether one of them held.
+  Outcome pin_neighbouring_integer(int j, bool far, bool* placed) {
+    const double v = layout_.y()[j];
+    *placed = false;
+    for (const double alt : {std::round(v), v < std::round(v) ? std::round(v) - 1 : std::round(v) + 1}) {
+      if (out_of_time()) return Outcome::kOutOfTime;
+      ++stats_->n_reverted;
+      pin({{j, alt}}, far);
+      if (!status_.is_ok()) return Outcome::kFailed;
+      if ((*placed = layout_.is_pinned(j))) break;
+    }
+    return Outcome::kDone;
+  }
+
   // Feature lines (free feature columns no required candidate depends on), in batches by
   // rounding error like the cones, so that the map can make room between close lines; a line
   // that reaches neither neighbouring integer (by a penalty homotopy) is released: it stays where
@@ -463,15 +478,8 @@ class Rounder {
       report_progress("features");
       for (const auto& [j, value] : targets) {
         if (layout_.is_pinned(j)) continue;
-        const double v = layout_.y()[j];
         bool placed = false;
-        for (const double alt : {std::round(v), v < std::round(v) ? std::round(v) - 1 : std::round(v) + 1}) {
-          if (out_of_time()) return Outcome::kOutOfTime;
-          ++stats_->n_reverted;
-          pin({{j, alt}}, true);
-          if (!status_.is_ok()) return Outcome::kFailed;
-          if ((placed = layout_.is_pinned(j))) break;
-        }
+        if (const Outcome o = pin_neighbouring_integer(j, true, &placed); o != Outcome::kDone) return o;
         if (!placed) released_[j] = 1;
       }
     }
@@ -493,13 +501,7 @@ class Rounder {
       if (layout_.is_pinned(j)) continue;
       const double v = layout_.y()[j];
       bool placed = false;
-      for (const double alt : {std::round(v), v < std::round(v) ? std::round(v) - 1 : std::round(v) + 1}) {
-        if (out_of_time()) return Outcome::kOutOfTime;
-        ++stats_->n_reverted;
-        pin({{j, alt}});
-        if (!status_.is_ok()) return Outcome::kFailed;
-        if ((placed = layout_.is_pinned(j))) break;
-      }
+      if (const Outcome o = pin_neighbouring_integer(j, false, &placed); o != Outcome::kDone) return o;
       if (!placed) {
         stuck_ = "a seam translation at " + std::to_string(v) + " reaches no integer flip-free";
         return Outcome::kStuck;
