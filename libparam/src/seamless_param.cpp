@@ -231,7 +231,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         }
         out.stats.seconds_local_estimation += seconds_since(tl);
       }
-      for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new, options.feature_max_tau))
+      for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
+                                         options.feature_max_wedge_stretch))
         proposed[i] = kDisabled;
     }
     const auto to = Clock::now();
@@ -516,6 +517,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
     return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
   if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
+  if (!(o.feature_max_tau > 1) || !(o.feature_max_wedge_stretch >= 1))
+    return core::Status::invalid_input("feature_max_tau must be > 1 and feature_max_wedge_stretch >= 1");
   if (mesh.n_faces() == 0) return core::Status::invalid_input("mesh has no faces");
   if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
   for (int f = 0; f < mesh.n_faces(); ++f) {
