@@ -102,7 +102,7 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
                                  const Eigen::VectorXd& x, const FeatureSet& fs,
                                  const std::vector<int>& label, const std::vector<char>& is_new,
-                                 double max_ratio) {
+                                 double max_ratio, double max_boundary_ratio) {
   const auto& topo = cut.topo;
   const int nv = mesh.n_vertices();
   std::vector<char> check(nv, 0);
@@ -130,6 +130,7 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
     double angle3d;  // the same on the surface
     int feature;
     int corner = 0;  // position in the fan (corners before it)
+    bool boundary = false;  // the first or last edge of an open fan
   };
   auto corner_angle3d = [&](int c) {
     const Eigen::Vector3d p = mesh.V.row(mesh.F(c / 3, c % 3));
@@ -152,7 +153,7 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
       total3d += corner_angle3d(c);
       const int next = topo.twin[prev_in_face(c)];
       if (next < 0) {
-        fan.push_back({total, total3d, fs.edge_feature[topo.face_edge(c / 3, (c % 3 + 2) % 3)]});
+        fan.push_back({total, total3d, fs.edge_feature[topo.face_edge(c / 3, (c % 3 + 2) % 3)], 0, true});
         break;
       }
       if (next == start[v]) {
@@ -161,6 +162,7 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
       }
       c = next;
     }
+    if (!closed && !fan.empty()) fan.front().boundary = true;
     for (bool changed = true; changed;) {
       changed = false;
       std::vector<Entry> on;
@@ -185,7 +187,8 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
                                       gap3d / (quarters * (std::numbers::pi / 2)));
         // Each triangle corner of the wedge opens less than 180°.
         const int corners = b.corner + (wraps ? n_corners : 0) - a.corner;
-        if (gap >= kMinWedge && ratio <= max_ratio && quarters < 2 * corners) continue;
+        const double bound = a.boundary || b.boundary ? max_boundary_ratio : max_ratio;
+        if (gap >= kMinWedge && ratio <= bound && quarters < 2 * corners) continue;
         int victim = -1;
         if (is_new[a.feature] && is_new[b.feature])
           victim = std::abs(delta[a.feature]) >= std::abs(delta[b.feature]) ? a.feature : b.feature;

@@ -50,11 +50,12 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 // 45° apart would close the faces between them (both along one direction). Returns the new
 // features to disable, one per such pair (the one farther from its axis), until no pair remains.
 // A pair whose wedge would open or close by more than max_ratio (its target angle, a multiple of
-// 90°, against its angle on the surface) is a conflict too: it would cost a distortion τ of about
-// that ratio (paper 8.4 disables features above τ 2.5).
+// 90°, against its angle on the surface) is a conflict too: it would cost a distortion of about
+// that ratio. A wedge bounded by a boundary edge (where an open mesh needs its corners) uses
+// max_boundary_ratio instead.
 std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
                                  const Eigen::VectorXd& x, const FeatureSet& fs,
                                  const std::vector<int>& label, const std::vector<char>& is_new,
-                                 double max_ratio);
+                                 double max_ratio, double max_boundary_ratio);
 
 }  // namespace quadify::param

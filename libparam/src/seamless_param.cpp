@@ -232,7 +232,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         out.stats.seconds_local_estimation += seconds_since(tl);
       }
       for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
-                                         options.feature_max_wedge_stretch))
+                                         options.feature_max_wedge_stretch, options.feature_max_tau))
         proposed[i] = kDisabled;
     }
     const auto to = Clock::now();

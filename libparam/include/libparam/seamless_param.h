@@ -70,7 +70,8 @@ struct ParamOptions {
   double feature_max_tau = 2.5;
   // Two features meeting at a vertex whose wedge would open or close by more than this factor
   // (its target angle, a multiple of 90°, against its angle on the surface) keep only the older
-  // label. 1.8 disables one of two creases meeting almost straight (180° on the surface cannot
+  // label (a wedge at a boundary, where open meshes need their corners, uses feature_max_tau).
+  // 1.8 disables one of two creases meeting almost straight (180° on the surface cannot
   // become 90° and 270° without degenerate quad corners there): measured on fandisk at 5,000
   // quads against 2.5: flipped quads 15 → 6, τ 2.91 → 2.20, feature capture 0.985 → 0.944.
   double feature_max_wedge_stretch = 1.8;
