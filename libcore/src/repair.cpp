@@ -23,11 +23,6 @@ namespace {
 
 using Tri = std::array<int, 3>;
 
-inline long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
-}
-
 struct DisjointSets {
   std::vector<int> parent;
   explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }

@@ -13,12 +13,6 @@
 namespace quadify::core {
 namespace {
 
-// Key of an undirected edge (a < b).
-inline long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
-}
-
 struct DisjointSets {
   std::vector<int> parent;
   explicit DisjointSets(int n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }

@@ -33,8 +33,6 @@ namespace {
 constexpr double kHomotopyWeights[] = {1e0, 1e2, 1e4, 1e6};
 // Newton stop of the homotopy stages (fraction of the energy): run the iterations out.
 constexpr double kHomotopyTolerance = 1e-12;
-// Exponent of the L^p ARAP density for Energy::kLinfArap (as in compute_seamless_param).
-constexpr double kLinfArapPower = 8;
 
 int find_root(std::vector<int>& parent, int i) {
   while (parent[i] != i) {
@@ -331,20 +329,9 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   res.n_flipped = options.reduce_only ? 0 : count_flipped(domain, x);
   if (!options.reduce_only && res.n_flipped == 0 && res.status.is_ok()) {
     OptimizeSettings st;
-    switch (options.energy) {
-      case Energy::kArap:
-        st.density = Density::kArap;
-        break;
-      case Energy::kLinfArap:
-        st.density = Density::kPowerArap;
-        st.power = kLinfArapPower;
-        break;
-      case Energy::kConformal:
-        st.density = Density::kMips;
-        break;
-      default:
-        st.density = Density::kSymmetricDirichlet;
-    }
+    const EnergyDensity ed = energy_density(options.energy);
+    st.density = ed.density;
+    st.power = ed.power;
     st.max_iterations = options.max_newton_iters;
     st.relative_tolerance = options.relative_tolerance;
     Eigen::VectorXd y = red.restrict(x);
@@ -399,8 +386,6 @@ constexpr double kPinRegularization = 1e-9;
 constexpr int kPinParallelMinFaces = 2048;
 // Consecutive stalled steps of PinnedLayout::pin before the blocking targets are dropped.
 constexpr int kStalledSteps = 2;
-// Exponent of the L^p ARAP density for Energy::kLinfArap (as in compute_seamless_param).
-constexpr double kPinLinfArapPower = 8;
 // Newton stop of a penalty stage (fraction of the energy).
 constexpr double kPinStageTolerance = 1e-8;
 // A penalty stage counts as progress for a target when its residual shrinks below this fraction.
@@ -480,13 +465,9 @@ struct PinnedLayout::Impl {
       const double a = domain.area[f];
       face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
       if (!derivatives || !ev.finite) return;
-      const Eigen::Matrix2d& dmi = domain.rest_inverse[f];
-      Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
-      for (int j = 0; j < 2; ++j)
-        for (int d = 0; d < 2; ++d)
-          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * j + d) = dmi(j, r);
-      const Eigen::Vector4d g4 = a * B.transpose() * ev.gradient;
-      const Eigen::Matrix4d h4 = a * B.transpose() * ev.hessian * B;
+      Eigen::Vector4d g4;
+      Eigen::Matrix4d h4;
+      edge_vector_derivatives(domain.rest_inverse[f], a, ev, &g4, &h4);
       const Face& el = faces[f];
       face_g[f].noalias() = el.M.transpose() * g4;
       face_h[f].noalias() = el.M.transpose() * h4 * el.M;
@@ -638,20 +619,9 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
     m.domain.rest_inverse[f] = dm.inverse();
     m.domain.area[f] = 0.5 * e1.cross(e2).norm();
   }
-  switch (options.energy) {
-    case Energy::kArap:
-      m.density = Density::kArap;
-      break;
-    case Energy::kLinfArap:
-      m.density = Density::kPowerArap;
-      m.power = kPinLinfArapPower;
-      break;
-    case Energy::kConformal:
-      m.density = Density::kMips;
-      break;
-    default:
-      m.density = Density::kSymmetricDirichlet;
-  }
+  const EnergyDensity ed = energy_density(options.energy);
+  m.density = ed.density;
+  m.power = ed.power;
 
   std::vector<char> never_pivot(n_vars, 0);
   never_pivot[0] = never_pivot[1] = 1;

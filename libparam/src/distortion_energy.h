@@ -3,6 +3,8 @@
 // Internal to libparam.
 #pragma once
 
+#include <libparam/seamless_param.h>
+
 #include <Eigen/Core>
 
 namespace quadify::param {
@@ -15,6 +17,22 @@ enum class Density {
                         // at an isometry)
   kMips,                // |J|²/det J = σ1/σ2 + σ2/σ1 (+inf when det J ≤ 0)
 };
+
+// The density and exponent that optimize a user-facing Energy: kTau is optimized as symmetric
+// Dirichlet (its L^p continuation is run separately), kLinfArap as L^8 ARAP.
+struct EnergyDensity {
+  Density density = Density::kSymmetricDirichlet;
+  double power = 1;
+};
+inline EnergyDensity energy_density(Energy energy) {
+  constexpr double kLinfArapPower = 8;
+  switch (energy) {
+    case Energy::kArap: return {Density::kArap, 1};
+    case Energy::kLinfArap: return {Density::kPowerArap, kLinfArapPower};
+    case Energy::kConformal: return {Density::kMips, 1};
+    default: return {Density::kSymmetricDirichlet, 1};
+  }
+}
 
 inline bool is_barrier(Density d) {
   return d == Density::kSymmetricDirichlet || d == Density::kPowerSD || d == Density::kMips;
@@ -31,5 +49,18 @@ struct DensityEval {
 // negative eigenvalues to zero (for Newton). `p` is the exponent of the power densities.
 DensityEval evaluate_density(Density kind, double p, const Eigen::Matrix2d& J, bool derivatives,
                              bool project_psd);
+
+// The derivatives of area·ψ(X·Dm⁻¹) over the face's edge vectors X = [x_1 − x_0, x_2 − x_0]
+// (local variable 2j + d: coordinate d of edge j), from ev's derivatives over vec(J) (index 2d+r).
+inline void edge_vector_derivatives(const Eigen::Matrix2d& rest_inverse, double area,
+                                    const DensityEval& ev, Eigen::Vector4d* g,
+                                    Eigen::Matrix4d* h) {
+  Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
+  for (int j = 0; j < 2; ++j)
+    for (int d = 0; d < 2; ++d)
+      for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * j + d) = rest_inverse(j, r);
+  *g = area * B.transpose() * ev.gradient;
+  *h = area * B.transpose() * ev.hessian * B;
+}
 
 }  // namespace quadify::param

@@ -292,16 +292,9 @@ struct LayoutProblem::Impl {
       const double a = domain.area[f];
       face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
       if (!derivatives || !ev.finite) return;
-      // B (4×6): vec(J) index 2d+r, local variable 2k+d, entry G(k, r).
-      // B (4×4): vec(J) index 2d+r, local variable 2j+d (coordinate d of x_{j+1} − x_0),
-      // entry Dm⁻¹(j, r).
-      const Eigen::Matrix2d& dmi = domain.rest_inverse[f];
-      Eigen::Matrix4d B = Eigen::Matrix4d::Zero();
-      for (int j = 0; j < 2; ++j)
-        for (int d = 0; d < 2; ++d)
-          for (int r = 0; r < 2; ++r) B(2 * d + r, 2 * j + d) = dmi(j, r);
-      const Eigen::Vector4d g4 = a * B.transpose() * ev.gradient;
-      const Eigen::Matrix4d h4 = a * B.transpose() * ev.hessian * B;
+      Eigen::Vector4d g4;
+      Eigen::Matrix4d h4;
+      edge_vector_derivatives(domain.rest_inverse[f], a, ev, &g4, &h4);
       const Element& el = faces[f];
       face_gy[f].noalias() = el.M.transpose() * g4;
       face_hy[f].noalias() = el.M.transpose() * h4 * el.M;

@@ -31,6 +31,7 @@
 #include <stdexcept>
 
 namespace quadify::param {
+using core::edge_key;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -49,8 +50,6 @@ constexpr double kTauPowers[] = {2, 4, 8, 16, 32, 64};
 // Newton iterations per continuation stage: each stage only needs to move the maximum, and
 // the stages follow each other closely.
 constexpr int kTauStageIterations = 15;
-// Exponent of the L^p ARAP energy for Energy::kLinfArap.
-constexpr double kLinfArapPower = 8;
 
 struct ComponentOutput {
   core::Status status;
@@ -60,12 +59,6 @@ struct ComponentOutput {
   std::vector<FeatureAlignment> features;  // component-local face ids
   ParamStats stats;
 };
-
-// Key of an undirected edge.
-long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
-}
 
 void add_timers(const OptimizeTimers& t, ParamStats* s) {
   s->seconds_setup += t.setup;
@@ -131,14 +124,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   double total_area = 0;
   for (double a : cut.area) total_area += a;
 
-  Density density = Density::kSymmetricDirichlet;
-  double power = 1;
-  if (options.energy == Energy::kArap) density = Density::kArap;
-  if (options.energy == Energy::kLinfArap) {
-    density = Density::kPowerArap;
-    power = kLinfArapPower;
-  }
-  if (options.energy == Energy::kConformal) density = Density::kMips;
+  const auto [density, power] = energy_density(options.energy);
 
   const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
   const int n_steps =

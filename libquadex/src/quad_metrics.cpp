@@ -28,6 +28,7 @@
 #include <unordered_map>
 
 namespace quadify::quadex {
+using core::edge_key;
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
@@ -57,11 +58,6 @@ void parallel_for_each_index(size_t n, const Body& body) {
 #else
   for (size_t i = 0; i < n; ++i) body(i);
 #endif
-}
-
-inline long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
 }
 
 struct DisjointSets {

@@ -1,5 +1,7 @@
 #include "render_svg.h"
 
+#include <libcore/topology.h>
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include <unordered_map>
 
 namespace quadify::cli {
+using core::edge_key;
 namespace {
 
 constexpr double kAzimuthDeg = 30;    // turn about the vertical, from the face-on view
@@ -21,11 +24,6 @@ constexpr double kAmbient = 0.35;     // Lambert: ambient + (1 - ambient)·max(0
 // in front of it: a remesher may cut a crease by about its Hausdorff distance (~1%).
 constexpr double kDepthTolerance = 0.015;
 constexpr double kHighlightStep = 0.75;  // pixels between visibility samples of a highlighted edge
-
-long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
-}
 
 // #rrggbb of an RGB colour in [0, 1].
 std::string hex_colour(const Eigen::Vector3d& rgb) {

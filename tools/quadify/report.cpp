@@ -12,6 +12,7 @@
 #include <map>
 
 namespace quadify::cli {
+using core::edge_key;
 namespace {
 constexpr auto kAnnounceAfter = std::chrono::seconds(1);  // stages shorter than this stay silent
 }
@@ -101,12 +102,6 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
       ->check(CLI::PositiveNumber);
 }
 
-namespace {
-long long edge_key(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
-}
-}  // namespace
 
 FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
                                 const LoadedMesh& loaded, param::ParamOptions* options) {

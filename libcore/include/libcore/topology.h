@@ -3,9 +3,16 @@
 
 #include <libcore/mesh.h>
 
+#include <utility>
 #include <vector>
 
 namespace quadify::core {
+
+// Key of the undirected edge {a, b} (vertex ids ≥ 0), the same for (a, b) and (b, a).
+inline long long edge_key(int a, int b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<long long>(a) << 32) | static_cast<unsigned>(b);
+}
 
 struct EdgeTopology {
   Eigen::MatrixX2i edge_vertex;  // #E×2, edge_vertex(e,0) < edge_vertex(e,1)
