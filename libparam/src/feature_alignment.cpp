@@ -120,9 +120,14 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
   }
   std::vector<int> lab = label;
   std::vector<double> delta(fs.size(), 0);
+  // The turn that brings each labeled feature onto its axis: to the nearest quarter of its
+  // label's parity (local estimation may have chosen the farther axis).
   for (int i = 0; i < fs.size(); ++i) {
     const double q = feature_measure(cut, x, fs.halfedge[i]);
-    delta[i] = (std::round(q) - q) * (std::numbers::pi / 2);
+    double target = std::round(q);
+    if ((label[i] == 0 || label[i] == 1) && nearest_label(q) != label[i])
+      target += q < target ? -1 : 1;
+    delta[i] = (target - q) * (std::numbers::pi / 2);
   }
   std::vector<int> disabled;
   struct Entry {

@@ -4,6 +4,7 @@
 #include "constraint_elimination.h"
 #include "cut_layout.h"
 #include "distortion_energy.h"
+#include "feature_alignment.h"
 #include "layout_optimizer.h"
 #include "local_estimation.h"
 #include "seam_basis.h"
@@ -368,6 +369,37 @@ TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
       << "distortions floor " << pc.distortion[0] << " ceil " << pc.distortion[1];
   EXPECT_LT(std::min(pc.distortion[0], pc.distortion[1]), 4 * 1.5 + 1e-9);
   EXPECT_EQ(pc.n_faces, 3);
+}
+
+TEST(FeatureAlignment, WedgeCheckUsesTheChosenAxisNotTheNearest) {
+  // Two opposite spokes of a disk's centre continue each other (180° on the surface). Labeled
+  // alike they stay straight; if local estimation gives one of them the other axis, the pair
+  // would turn by 90° (a stretch of 2, a flat quad corner): the wedge check must see that turn.
+  const core::TriMesh mesh = test::make_disk(4, 12);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  const Eigen::VectorXd x = flatten(isometric_unfold(mesh, cut));
+  std::vector<int> spokes(2, -1);
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    for (int k = 0; k < 2; ++k)
+      if (cut.topo.edge_vertex(e, k) == 0) {
+        const int w = cut.topo.edge_vertex(e, 1 - k);
+        if (w == 1) spokes[0] = e;
+        if (w == 1 + 6) spokes[1] = e;  // sector 6 of 12: the opposite direction
+      }
+  ASSERT_GE(spokes[0], 0);
+  ASSERT_GE(spokes[1], 0);
+  const FeatureSet fs = make_feature_set(cut, spokes);
+  ASSERT_EQ(fs.size(), 2);
+  std::vector<int> label(2);
+  for (int i = 0; i < 2; ++i) label[i] = nearest_label(feature_measure(cut, x, fs.halfedge[i]));
+  ASSERT_EQ(label[0], label[1]) << "opposite directions share an axis";
+  const std::vector<char> is_new = {1, 1};
+  constexpr double kMaxStretch = 1.8;
+  EXPECT_TRUE(wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch).empty());
+  label[1] = 1 - label[1];
+  const std::vector<int> disabled = wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch);
+  ASSERT_EQ(disabled.size(), 1u);
+  EXPECT_EQ(disabled[0], 1) << "the feature off its nearest axis is the one turned farthest";
 }
 
 }  // namespace

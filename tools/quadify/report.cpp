@@ -100,6 +100,12 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
                  "Disable a feature whose locally estimated distortion tau stays above this")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--feature-max-wedge-stretch", a->max_wedge_stretch,
+                 "Where two features meet, the angle between them may be stretched or shrunk by at "
+                 "most this factor to become a multiple of 90 degrees (else one is disabled); lower "
+                 "values avoid flat quad corners where creases meet almost straight")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
 }
 
 
@@ -110,6 +116,7 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   const core::EdgeTopology topo = core::build_edge_topology(mesh);
   options->align_boundaries = args.boundaries;
   options->feature_max_tau = args.max_tau;
+  options->feature_max_wedge_stretch = args.max_wedge_stretch;
   options->feature_edges.clear();
   if (args.angle_deg > 0)
     for (const int e : core::sharp_edges(mesh, topo, args.angle_deg))
