@@ -23,6 +23,11 @@
 //    dropped and try other free grid points (or the other neighbouring integer) one at a time.
 //    A run that still dead-ends restarts at nearby scales (×1 ± 2%, ±4%), then at scales grown
 //    by ×1.25 (max_scale_retries times). options.time_budget_seconds bounds the whole.
+//    Aligned feature lines are optional candidates. They are rounded after the cones and before
+//    the translations (they get the first choice of the room), and a line that reaches no integer
+//    is released. If a translation then dead-ends (pinned lines in its way), the run is repeated
+//    with the lines rounded last, where they cannot block a required unknown; only if that too
+//    dead-ends are the features dropped.
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
@@ -75,7 +80,8 @@ constexpr size_t kConeAlternatives = 4;
 // Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
 constexpr double kConePairMeshEdges = 8;
 // Scales tried with the aligned features before they are dropped: only the target (a dead end
-// with features is rarely rescued by a jitter, and each attempt costs a full rounding run).
+// with features is rarely rescued by a jitter, and each attempt costs a full rounding run), in
+// both orders (feature lines before the translations, then after them).
 constexpr size_t kFeatureScaleTries = 1;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
@@ -153,7 +159,7 @@ class Rounder {
   Rounder(const core::TriMesh& mesh, const param::CopyLayout& cl,
           const std::vector<Candidate>& candidates, const std::vector<char>& is_cone_copy,
           const QuantizeOptions& options, QuantizeStats* stats, Clock::time_point deadline,
-          std::string scale_label)
+          std::string scale_label, bool features_last = false)
       : mesh_(mesh),
         cl_(cl),
         cand_(candidates),
@@ -161,7 +167,8 @@ class Rounder {
         opt_(options),
         stats_(stats),
         deadline_(deadline),
-        label_(std::move(scale_label)) {}
+        label_(std::move(scale_label)),
+        features_last_(features_last) {}
 
   Outcome run(const Eigen::VectorXd& x, const param::PinnedLayoutOptions& layout_options) {
     auto tc = Clock::now();
@@ -173,8 +180,13 @@ class Rounder {
     stats_->n_iterations += layout_.minimize(opt_.max_newton_iters, kBatchTolerance, &status_);
     if (!status_.is_ok()) return Outcome::kFailed;
     Outcome outcome = round_cones();
-    if (outcome == Outcome::kDone) outcome = round_features();
-    if (outcome == Outcome::kDone) outcome = round_others();
+    if (features_last_) {
+      if (outcome == Outcome::kDone) outcome = round_others();
+      if (outcome == Outcome::kDone) outcome = round_features();
+    } else {
+      if (outcome == Outcome::kDone) outcome = round_features();
+      if (outcome == Outcome::kDone) outcome = round_others();
+    }
     stats_->seconds_rounding += seconds_since(tc);
     if (outcome != Outcome::kDone) return outcome;
     tc = Clock::now();
@@ -196,6 +208,8 @@ class Rounder {
   int n_integer_columns() const { return static_cast<int>(int_cols_.size()); }
   int n_pinned() const { return n_pinned_; }
   const std::string& stuck_reason() const { return stuck_; }
+  // Whether the dead end came while rounding the cones (which go first in either order).
+  bool stuck_on_cones() const { return stuck_on_cones_; }
 
  private:
   // A cone copy whose two coordinates are free variables.
@@ -254,6 +268,9 @@ class Rounder {
   }
 
   bool out_of_time() const { return Clock::now() > deadline_; }
+
+  // A feature line no cone or translation depends on: it may stay unpinned (released).
+  bool optional_col(int j) const { return feature_col_[j] && !required_col_[j]; }
 
   // Pins (column, value) targets; returns the per-target pinned flags.
   std::vector<char> pin(const std::vector<std::pair<int, double>>& targets, bool far = false) {
@@ -402,6 +419,7 @@ class Rounder {
       }
       if (!placed) {
         const Eigen::Vector2d p = position(c);
+        stuck_on_cones_ = true;
         stuck_ = "cone vertex " + std::to_string(cl_.copy_vertex[c.copy]) + " at (" +
                  std::to_string(p.x()) + ", " + std::to_string(p.y()) +
                  ") reaches no free grid point flip-free";
@@ -467,7 +485,7 @@ class Rounder {
       const double eps = opt_.threshold_step * (step + 1);
       std::vector<std::pair<int, double>> targets;
       for (const int j : int_cols_) {
-        if (!feature_col_[j] || required_col_[j] || layout_.is_pinned(j) || released_[j]) continue;
+        if (!optional_col(j) || layout_.is_pinned(j) || released_[j]) continue;
         const double v = layout_.y()[j];
         if (step + 1 == n_steps || std::abs(v - std::round(v)) < eps) targets.push_back({j, std::round(v)});
       }
@@ -487,11 +505,13 @@ class Rounder {
   }
 
   // The remaining integer columns (translations and lone cone coordinates) to their nearest
-  // integers in one batch; a blocked one then tries its other neighbouring integer.
+  // integers in one batch; a blocked one then tries both neighbouring integers alone. With
+  // features_last_, feature lines no required candidate depends on are left to round_features.
   Outcome round_others() {
     std::vector<std::pair<int, double>> targets;
     for (const int j : int_cols_)
-      if (!layout_.is_pinned(j) && !released_[j]) targets.push_back({j, std::round(layout_.y()[j])});
+      if (!layout_.is_pinned(j) && !released_[j] && !(features_last_ && optional_col(j)))
+        targets.push_back({j, std::round(layout_.y()[j])});
     if (targets.empty()) return Outcome::kDone;
     if (out_of_time()) return Outcome::kOutOfTime;
     pin(targets);
@@ -501,7 +521,12 @@ class Rounder {
       if (layout_.is_pinned(j)) continue;
       const double v = layout_.y()[j];
       bool placed = false;
-      if (const Outcome o = pin_neighbouring_integer(j, false, &placed); o != Outcome::kDone) return o;
+      // Both neighbouring integers by Newton steps, then by the penalty homotopy (which can
+      // carry the map farther, e.g. past an aligned feature line in the way).
+      for (const bool far : {false, true}) {
+        if (placed) break;
+        if (const Outcome o = pin_neighbouring_integer(j, far, &placed); o != Outcome::kDone) return o;
+      }
       if (!placed) {
         stuck_ = "a seam translation at " + std::to_string(v) + " reaches no integer flip-free";
         return Outcome::kStuck;
@@ -518,6 +543,7 @@ class Rounder {
   QuantizeStats* stats_;
   Clock::time_point deadline_;
   std::string label_;
+  bool features_last_;  // translations before feature lines (they cannot block a translation)
   param::PinnedLayout layout_;
   core::Status status_;
   std::vector<int> int_cols_;
@@ -526,6 +552,7 @@ class Rounder {
   std::map<GridKey, int> occupied_;  // grid points of pinned cones → their mesh vertex
   int n_pinned_ = 0;
   std::string stuck_;
+  bool stuck_on_cones_ = false;
 };
 
 // Whether a is a multiple of 2^-kMaxDenominatorBits (exactly).
@@ -708,14 +735,21 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     scales.push_back(scale * std::pow(options.scale_growth, r));
   // With aligned features, the target scale keeps them; if it dead-ends (feature curves closer
   // than the grid allows), the features are dropped and every scale is tried without them.
-  std::vector<std::pair<double, bool>> attempts;
+  struct Attempt {
+    double scale;
+    bool with_features, features_last;
+  };
+  std::vector<Attempt> attempts;
   if (!feature_rows.empty())
-    for (size_t i = 0; i < std::min<size_t>(kFeatureScaleTries, scales.size()); ++i) attempts.push_back({scales[i], true});
-  for (const double sc : scales) attempts.push_back({sc, false});
+    for (size_t i = 0; i < std::min<size_t>(kFeatureScaleTries, scales.size()); ++i) {
+      attempts.push_back({scales[i], true, false});
+      attempts.push_back({scales[i], true, true});
+    }
+  for (const double sc : scales) attempts.push_back({sc, false, false});
   for (int attempt = 0; attempt < static_cast<int>(attempts.size()); ++attempt) {
     st.n_scale_retries = attempt;
-    scale = attempts[attempt].first;
-    const bool with_features = attempts[attempt].second;
+    scale = attempts[attempt].scale;
+    const bool with_features = attempts[attempt].with_features;
     lopt.extra_rows = with_features ? feature_rows : std::vector<param::AffineRow>{};
     lopt.prefer_free_coords = with_features ? feature_coords : std::vector<char>{};
     const std::vector<Candidate>& attempt_candidates = with_features ? candidates : base_candidates;
@@ -725,9 +759,12 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       x.segment<2>(2 * k) =
           scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
     lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
-    char label[32];
-    std::snprintf(label, sizeof label, "x%.3f%s", scale / scales[0], with_features ? "" : feature_rows.empty() ? "" : " no-features");
-    Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st, deadline, label);
+    char label[48];
+    std::snprintf(label, sizeof label, "x%.3f%s", scale / scales[0],
+                  with_features ? (attempts[attempt].features_last ? " features-last" : "")
+                                : (feature_rows.empty() ? "" : " no-features"));
+    Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st, deadline, label,
+                    attempts[attempt].features_last);
     const Rounder::Outcome outcome = rounder.run(x, lopt);
     st.n_integer_dofs = rounder.n_integer_columns();
     if (outcome == Rounder::Outcome::kFailed) {
@@ -748,6 +785,10 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     }
     if (outcome == Rounder::Outcome::kStuck) {
       last_stuck = rounder.stuck_reason();
+      // The cones are rounded first in both orders: the other order would dead-end alike.
+      if (with_features && rounder.stuck_on_cones() && attempt + 1 < static_cast<int>(attempts.size()) &&
+          attempts[attempt + 1].with_features && attempts[attempt + 1].scale == scale)
+        ++attempt;
       continue;
     }
     Eigen::VectorXd xe;
