@@ -89,7 +89,7 @@ struct FeatureArgs {
   bool from_obj_lines = true;  // OBJ `l` lines of the input are feature edges too
   bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
   double max_tau = 2.5;      // --feature-max-tau
-  double max_wedge_stretch = 2.5;  // --feature-max-wedge-stretch
+  double max_wedge_stretch = 1.8;  // --feature-max-wedge-stretch
 };
 void add_feature_options(CLI::App& app, FeatureArgs* args);
 // Sets options->feature_edges (detected sharp edges, the file's and the OBJ's feature lines,

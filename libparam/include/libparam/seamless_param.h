@@ -71,12 +71,12 @@ struct ParamOptions {
   // Two features meeting at a vertex whose wedge would open or close by more than this factor
   // (its target angle, a multiple of 90°, against its angle on the surface) keep only the older
   // label (a wedge at a boundary, where open meshes need their corners, uses feature_max_tau).
-  // Creases meeting almost straight (180° on the surface) become 90° and 270° below 2: a lower
-  // bound disables one of them, trading capture for quad shape. Measured on fandisk at 5,000
-  // quads, 1.8 against 2.5: flipped (degenerate-corner) quads 15 → 6, τ 2.91 → 2.20, feature
-  // capture 0.985 → 0.944; but beetle's features then no longer fit the grid (capture 0.98 →
-  // 0.17), so the default stays at the τ bound.
-  double feature_max_wedge_stretch = 2.5;
+  // Creases meeting almost straight (180° on the surface) would become 90° and 270° (a stretch
+  // of 2, a flat quad corner counted as flipped): below 2, one of them is disabled instead.
+  // Measured at 5,000 quads (with the wedge check fixed to use each label's own axis), 1.8
+  // against 2.5: flipped quads fandisk 16 → 1, beetle 20 → 14, wingnut 1 → 0, for feature capture
+  // fandisk 0.982 → 0.950 and beetle 0.980 → 0.932 (wingnut 0.807 → 0.846).
+  double feature_max_wedge_stretch = 1.8;
   // Rotate the initial layout so that the largest group of feature directions lies along the u
   // axis (Alg. 4, k-means of the feature edge directions on the unit circle).
   bool feature_global_rotation = true;
