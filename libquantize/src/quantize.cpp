@@ -785,6 +785,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     }
     if (outcome == Rounder::Outcome::kStuck) {
       last_stuck = rounder.stuck_reason();
+      if (with_features) st.features_dropped_reason = last_stuck;
       // The cones are rounded first in both orders: the other order would dead-end alike.
       if (with_features && rounder.stuck_on_cones() && attempt + 1 < static_cast<int>(attempts.size()) &&
           attempts[attempt + 1].with_features && attempts[attempt + 1].scale == scale)
@@ -801,6 +802,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     }
     st.scale = scale;
     st.features_dropped = !feature_rows.empty() && !with_features;
+    if (!st.features_dropped) st.features_dropped_reason.clear();
     st.n_released_feature_lines = rounder.n_released();
     if (!with_features) candidates.resize(n_base_candidates);
     st.n_candidates = static_cast<int>(candidates.size());

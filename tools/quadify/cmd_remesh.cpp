@@ -88,12 +88,14 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
   bool features_dropped = false;
+  std::string features_dropped_reason;
   if (integer_map.status.is_ok() && integer_map.stats.features_dropped) {
     features_dropped = true;
+    features_dropped_reason = integer_map.stats.features_dropped_reason;
     if (!common.quiet)
-      std::fprintf(stderr, "quadify: %s: the aligned features do not fit the quad grid at this density; "
+      std::fprintf(stderr, "quadify: %s: the aligned features do not fit the quad grid at this density (%s); "
                            "remeshing without them (a larger --target-faces may keep them)\n",
-                   args.input.c_str());
+                   args.input.c_str(), integer_map.stats.features_dropped_reason.c_str());
     param_options.feature_edges.clear();
     param_options.align_boundaries = false;
     seamless = parametrize(param_options);
@@ -158,6 +160,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"aligned_features", qs.n_aligned_features},
                         {"released_feature_lines", qs.n_released_feature_lines},
                         {"features_dropped", features_dropped || qs.features_dropped},
+                        {"features_dropped_reason", features_dropped ? features_dropped_reason
+                                                                     : qs.features_dropped_reason},
                         {"clustered_cones", qs.n_clustered_cones},
                         {"cone_collisions", qs.n_cone_collisions},
                         {"newton_iterations", qs.n_iterations},
@@ -174,6 +178,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"flipped_before", relax_stats.n_flipped_before},
                        {"flipped_after", relax_stats.n_flipped_after},
                        {"moves", relax_stats.n_moves},
+                       {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
                        {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");

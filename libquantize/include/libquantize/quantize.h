@@ -9,8 +9,8 @@
 
 #include <array>
 #include <functional>
-#include <vector>
 #include <string>
+#include <vector>
 
 namespace quadify::quantize {
 
@@ -68,6 +68,7 @@ struct QuantizeStats {
   int n_aligned_features = 0;
   int n_released_feature_lines = 0;
   bool features_dropped = false;
+  std::string features_dropped_reason;  // why the rounding with the features dead-ended
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
   int n_iterations = 0;       // Newton iterations (one factorization each) in total
