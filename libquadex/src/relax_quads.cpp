@@ -36,6 +36,8 @@ constexpr double kOnFeature = 1e-9;
 
 // Fraction of the way to the neighbour centroid tried after the full step is refused.
 constexpr double kHalfStep = 0.5;
+// Fractions of the way to the centroid of a bad quad the vertex belongs to, tried next.
+constexpr double kIntoQuadSteps[] = {0.3, 0.1};
 // A move is kept when it raises the local worst scaled Jacobian by more than this (round-off).
 constexpr double kMinImprovement = 1e-9;
 
@@ -86,11 +88,12 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       if (d == 4) vertex_quads[a].push_back(f);
     }
   }
-  std::vector<char> fixed(nv, 0);
+  std::vector<char> fixed(nv, 0), on_feature(nv, 0), non_manifold(nv, 0);
   for (const auto& [e, count] : edge_faces) {
     neighbours[e.first].push_back(e.second);
     neighbours[e.second].push_back(e.first);
     if (count != 2) fixed[e.first] = fixed[e.second] = 1;
+    if (count > 2) non_manifold[e.first] = non_manifold[e.second] = 1;
   }
   for (int v = 0; v < nv; ++v)
     if (vertex_quads[v].empty()) fixed[v] = 1;
@@ -112,7 +115,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       for (int v = 0; v < nv; ++v)
         if (!fixed[v] &&
             features.squared_distance(Point(quads.V(v, 0), quads.V(v, 1), quads.V(v, 2))) <= tol2)
-          fixed[v] = 1;
+          on_feature[v] = 1;
     }
   }
 
@@ -123,64 +126,100 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       if (q.degree(f) == 4 && quad_sj(q, f) < threshold) ++n;
     return n;
   };
+  const double kFlipped = std::numeric_limits<double>::min();
   res.stats.n_bad_before = count_bad(options.min_scaled_jacobian);
-  res.stats.n_flipped_before = count_bad(std::numeric_limits<double>::min());
+  res.stats.n_flipped_before = count_bad(kFlipped);
   auto local_worst = [&](int v) {
     double w = std::numeric_limits<double>::infinity();
     for (int f : vertex_quads[v]) w = std::min(w, quad_sj(q, f));
     return w;
   };
-  for (int round = 0; round < options.max_rounds; ++round) {
-    // Vertices to move: those of bad quads, grown by `rings` neighbour rings.
-    std::vector<char> in_set(nv, 0);
-    std::vector<int> set;
-    for (int f = 0; f < nf; ++f)
-      if (q.degree(f) == 4 && quad_sj(q, f) < options.min_scaled_jacobian)
-        for (int k = 0; k < 4; ++k)
-          if (!in_set[q.vertex(f, k)]) {
-            in_set[q.vertex(f, k)] = 1;
-            set.push_back(q.vertex(f, k));
+  // Rounds over the vertices of the quads below `threshold` (and `rings` rings around them);
+  // `frozen` vertices do not move. Each vertex tries the centroid of its neighbours (full and
+  // half step), then steps into each bad quad it belongs to (which opens a flat or reflex corner
+  // there); a move is kept when the worst corner around the vertex improves. Returns the moves.
+  auto relax_rounds = [&](const std::vector<char>& frozen, double threshold) {
+    int total = 0;
+    for (int round = 0; round < options.max_rounds; ++round) {
+      std::vector<char> in_set(nv, 0);
+      std::vector<int> set;
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4 && quad_sj(q, f) < threshold)
+          for (int k = 0; k < 4; ++k)
+            if (!in_set[q.vertex(f, k)]) {
+              in_set[q.vertex(f, k)] = 1;
+              set.push_back(q.vertex(f, k));
+            }
+      if (set.empty()) break;
+      for (int r = 0; r < options.rings; ++r) {
+        const size_t n = set.size();
+        for (size_t i = 0; i < n; ++i)
+          for (int w : neighbours[set[i]])
+            if (!in_set[w]) {
+              in_set[w] = 1;
+              set.push_back(w);
+            }
+      }
+      std::sort(set.begin(), set.end());
+      int moves = 0;
+      for (int v : set) {
+        if (frozen[v]) continue;
+        const Eigen::Vector3d old = q.V.row(v).transpose();
+        const double before = local_worst(v);
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (int w : neighbours[v]) centroid += q.V.row(w).transpose();
+        centroid /= static_cast<double>(neighbours[v].size());
+        std::vector<Eigen::Vector3d> targets;
+        for (const double step : {1.0, kHalfStep}) targets.push_back(old + step * (centroid - old));
+        for (int f : vertex_quads[v]) {
+          if (quad_sj(q, f) >= threshold) continue;
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (int k = 0; k < 4; ++k) c += q.V.row(q.vertex(f, k)).transpose();
+          for (const double step : kIntoQuadSteps) targets.push_back(old + step * (0.25 * c - old));
+        }
+        bool kept = false;
+        for (const Eigen::Vector3d& target : targets) {
+          const Point p = tree.closest_point(Point(target.x(), target.y(), target.z()));
+          q.V.row(v) << p.x(), p.y(), p.z();
+          if (local_worst(v) > before + kMinImprovement) {
+            kept = true;
+            break;
           }
-    if (set.empty()) break;
-    for (int r = 0; r < options.rings; ++r) {
-      const size_t n = set.size();
-      for (size_t i = 0; i < n; ++i)
-        for (int w : neighbours[set[i]])
-          if (!in_set[w]) {
-            in_set[w] = 1;
-            set.push_back(w);
-          }
-    }
-    std::sort(set.begin(), set.end());
-    int moves = 0;
-    for (int v : set) {
-      if (fixed[v]) continue;
-      const Eigen::Vector3d old = q.V.row(v).transpose();
-      const double before = local_worst(v);
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (int w : neighbours[v]) centroid += q.V.row(w).transpose();
-      centroid /= static_cast<double>(neighbours[v].size());
-      bool kept = false;
-      for (const double step : {1.0, kHalfStep}) {
-        const Eigen::Vector3d target = old + step * (centroid - old);
-        const Point p = tree.closest_point(Point(target.x(), target.y(), target.z()));
-        q.V.row(v) << p.x(), p.y(), p.z();
-        if (local_worst(v) > before + kMinImprovement) {
-          kept = true;
-          break;
+        }
+        if (kept) {
+          ++moves;
+        } else {
+          q.V.row(v) = old.transpose();
         }
       }
-      if (kept) {
-        ++moves;
-      } else {
-        q.V.row(v) = old.transpose();
-      }
+      total += moves;
+      if (moves == 0) break;
     }
-    res.stats.n_moves += moves;
-    if (moves == 0) break;
+    return total;
+  };
+  std::vector<char> frozen(nv);
+  for (int v = 0; v < nv; ++v) frozen[v] = fixed[v] || on_feature[v];
+  res.stats.n_moves = relax_rounds(frozen, options.min_scaled_jacobian);
+  // Last resort for quads still flipped: their vertices on features and boundaries may leave
+  // them (a flipped or flat quad is worse than a crease or boundary missed by a fraction of a
+  // quad: e.g. a boundary corner placed where the boundary runs straight).
+  if (options.release_features_for_flips && count_bad(kFlipped) > 0) {
+    std::vector<char> released(nv, 0);
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) == 4 && quad_sj(q, f) < kFlipped)
+        for (int k = 0; k < 4; ++k) {
+          const int v = q.vertex(f, k);
+          if ((on_feature[v] || fixed[v]) && !non_manifold[v] && !vertex_quads[v].empty()) released[v] = 1;
+        }
+    const Eigen::MatrixX3d v_before = q.V;
+    for (int v = 0; v < nv; ++v)
+      if (released[v]) frozen[v] = 0;
+    res.stats.n_moves += relax_rounds(frozen, kFlipped);
+    for (int v = 0; v < nv; ++v)
+      if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
   }
   res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
-  res.stats.n_flipped_after = count_bad(std::numeric_limits<double>::min());
+  res.stats.n_flipped_after = count_bad(kFlipped);
   res.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }

@@ -63,6 +63,32 @@ TEST(RelaxQuads, LeavesAGoodGridUnchanged) {
   EXPECT_EQ(r.quads.V, q.V);
 }
 
+TEST(RelaxQuads, LastResortMovesAFeatureVertexOffAFlatCorner) {
+  // The diagonal of the square is a feature. Vertex (2, 1) is pulled onto it at (1.5, 1.5): the
+  // quad (1,1)-(2,1)-(2,2)-(1,2) gets three vertices on the feature and a flat corner there.
+  // Vertices on features stay fixed, so only the last resort (moving it off the feature) repairs
+  // the quad.
+  const int n = 4;
+  core::PolyMesh q = grid(n);
+  const int v = 1 * (n + 1) + 2;
+  q.V.row(v) << 1.5, 1.5, 0;
+  RelaxOptions o;
+  o.feature_edges = {{0, 2}};  // square(n) vertex 0 = (0, 0), vertex 2 = (n, n)
+  o.release_features_for_flips = false;
+  const RelaxResult kept = relax_bad_quads(q, square(n), o);
+  ASSERT_TRUE(kept.status.is_ok()) << kept.status.to_string();
+  EXPECT_GE(kept.stats.n_flipped_before, 1);
+  EXPECT_GE(kept.stats.n_flipped_after, 1) << "the flat corner's vertex is on the feature";
+  EXPECT_EQ(kept.quads.V.row(v), q.V.row(v));
+  o.release_features_for_flips = true;
+  const RelaxResult r = relax_bad_quads(q, square(n), o);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_flipped_after, 0);
+  EXPECT_GE(r.stats.n_feature_vertices_moved, 1);
+  EXPECT_NE(r.quads.V.row(v), q.V.row(v));
+  for (int w = 0; w < q.n_vertices(); ++w) EXPECT_NEAR(r.quads.V(w, 2), 0.0, 1e-12);
+}
+
 TEST(RelaxQuads, RejectsBadInput) {
   core::PolyMesh q = grid(2);
   q.face_vertex[0] = 99;

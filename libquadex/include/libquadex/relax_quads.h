@@ -24,8 +24,13 @@ struct RelaxOptions {
   // Vertex rings around the bad quads' vertices that may move too (room to spread the fix).
   int rings = 1;
   // Feature edges of the surface (vertex-id pairs): quad vertices on them (within 1e-9 of the
-  // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains.
+  // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains
+  // (but see release_features_for_flips).
   std::vector<std::array<int, 2>> feature_edges;
+  // Quads still flipped after that may move their vertices on features and boundaries too (off
+  // the curve: a flipped or flat quad is worse than a crease or boundary missed by a fraction of
+  // a quad), as a last resort.
+  bool release_features_for_flips = true;
 };
 
 struct RelaxStats {
@@ -33,6 +38,7 @@ struct RelaxStats {
   int n_bad_after = 0;   // and after
   int n_flipped_before = 0, n_flipped_after = 0;  // quads with a corner scaled Jacobian ≤ 0
   int n_moves = 0;       // accepted vertex moves
+  int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
   double seconds = 0;
 };
 
