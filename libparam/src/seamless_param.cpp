@@ -586,7 +586,23 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
       std::lock_guard<std::mutex> lock(progress_mutex);
       options.progress(stage, step, n_steps);
     };
-  auto work = [&](int c) { outs[c] = run_component(sub[c], component_options, sub_features[c]); };
+  // A component whose parametrization fails with its features (a batch that no flip-free move
+  // reaches because of features aligned in earlier batches) is parametrized again without them:
+  // its features count as disabled.
+  ParamOptions plain_options = component_options;
+  plain_options.align_boundaries = false;
+  std::vector<char> fell_back(n_comp, 0);
+  auto work = [&](int c) {
+    outs[c] = run_component(sub[c], component_options, sub_features[c]);
+    if (outs[c].status.is_ok() || outs[c].status.code() == core::StatusCode::kInvalidInput ||
+        outs[c].stats.n_feature_edges == 0)
+      return;
+    const int n_features = outs[c].stats.n_feature_edges;
+    outs[c] = run_component(sub[c], plain_options, {});
+    outs[c].stats.n_feature_edges = n_features;
+    outs[c].stats.n_disabled_features = n_features;
+    fell_back[c] = 1;
+  };
 #ifdef QUADIFY_WITH_TBB
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] { tbb::parallel_for(0, n_comp, work); });
@@ -612,6 +628,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     for (const FeatureAlignment& fa : o.features)
       result.features.push_back({sub_faces[c][fa.face], fa.corner, fa.constant_coord});
     st.n_feature_edges += o.stats.n_feature_edges;
+    st.n_feature_fallbacks += fell_back[c];
     st.n_aligned_features += o.stats.n_aligned_features;
     st.n_disabled_features += o.stats.n_disabled_features;
     st.n_feature_patches += o.stats.n_feature_patches;

@@ -40,6 +40,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
   progress.begin("param");
   const param::ParamResult result = param::compute_seamless_param(loaded.repaired.mesh, options);
   progress.end();
+  warn_feature_fallbacks(args.input, result.stats, common.quiet);
   if (result.status.code() == core::StatusCode::kInvalidInput)
     throw CliError{kExitBadInput, args.input + ": " + result.status.message()};
   if (!result.status.is_ok() && result.status.code() != core::StatusCode::kNotConverged)

@@ -75,6 +75,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     progress.begin("param");
     param::ParamResult result = param::compute_seamless_param(mesh, options);
     progress.end();
+    warn_feature_fallbacks(args.input, result.stats, common.quiet);
     if (result.status.code() == core::StatusCode::kInvalidInput)
       throw CliError{kExitBadInput, args.input + ": " + result.status.message()};
     if (!result.status.is_ok())

@@ -192,6 +192,14 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   return fi;
 }
 
+void warn_feature_fallbacks(const std::string& input, const param::ParamStats& stats, bool quiet) {
+  if (quiet || stats.n_feature_fallbacks == 0) return;
+  std::fprintf(stderr,
+               "quadify: %s: %d of %d components could not be parametrized flip-free with their "
+               "features and were parametrized without them\n",
+               input.c_str(), stats.n_feature_fallbacks, stats.n_components);
+}
+
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
   return {{"detected_sharp_edges", fi.n_detected},
           {"given_edges", fi.n_given},
@@ -201,6 +209,7 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"aligned", s.n_aligned_features},
           {"disabled", s.n_disabled_features},
           {"patches", s.n_feature_patches},
+          {"components_without_features", s.n_feature_fallbacks},
           {"alignment_error", number(s.feature_alignment_error)}};
 }
 

@@ -92,6 +92,9 @@ struct FeatureArgs {
   double max_wedge_stretch = 1.8;  // --feature-max-wedge-stretch
 };
 void add_feature_options(CLI::App& app, FeatureArgs* args);
+// One line on stderr (unless quiet) when components of `input` fell back to a parametrization
+// without their features (param::ParamStats::n_feature_fallbacks).
+void warn_feature_fallbacks(const std::string& input, const param::ParamStats& stats, bool quiet);
 // Sets options->feature_edges (detected sharp edges, the file's and the OBJ's feature lines,
 // mapped onto the repaired mesh), align_boundaries and feature_max_tau. Throws CliError naming
 // the file for an unreadable edge file or an edge that is not an edge of the input.

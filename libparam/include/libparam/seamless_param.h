@@ -103,6 +103,8 @@ struct ParamStats {
   int n_disabled_features = 0; // feature edges whose alignment was disabled (τ bound, wedge
                                // conflicts, or a batch that could not be made flip-free)
   int n_feature_patches = 0;   // local-estimation patches laid out for feature labels
+  int n_feature_fallbacks = 0; // components that failed with their features and were
+                               // parametrized again without them (all counted as disabled)
   double feature_alignment_error = 0;  // max |Δ constant coordinate| / |edge| over aligned ones
   int total_iterations = 0;    // Newton iterations over all optimizations (global layout)
   int n_flipped = 0;           // faces with non-positive UV orientation (exact predicate)
