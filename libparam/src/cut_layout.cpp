@@ -154,27 +154,28 @@ std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d
   return m;
 }
 
+SparseRow make_row(std::vector<std::pair<int, double>> terms) {
+  std::sort(terms.begin(), terms.end());
+  SparseRow row;
+  for (const auto& [var, coef] : terms) {
+    if (!row.entries.empty() && row.entries.back().first == var)
+      row.entries.back().second += coef;
+    else
+      row.entries.push_back({var, coef});
+  }
+  std::erase_if(row.entries, [](const auto& p) { return p.second == 0.0; });
+  return row;
+}
+
 std::array<SparseRow, 2> seam_constraint_rows(const CutMesh& cut, int seam, int matching) {
   const SeamEnds c = seam_ends(cut, seam);
   const int r = ((matching % 4) + 4) % 4;
-  // (R^r e)[d] = sign[d] · e[src[d]].
-  static constexpr int kSrc[4][2] = {{0, 1}, {1, 0}, {0, 1}, {1, 0}};
-  static constexpr double kSign[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
   std::array<SparseRow, 2> rows;
-  for (int d = 0; d < 2; ++d) {
-    std::vector<std::pair<int, double>> e = {{2 * c.b1 + d, 1.0},
-                                             {2 * c.b0 + d, -1.0},
-                                             {2 * c.a1 + kSrc[r][d], -kSign[r][d]},
-                                             {2 * c.a0 + kSrc[r][d], kSign[r][d]}};
-    std::sort(e.begin(), e.end());
-    for (const auto& [var, coef] : e) {
-      if (!rows[d].entries.empty() && rows[d].entries.back().first == var)
-        rows[d].entries.back().second += coef;
-      else
-        rows[d].entries.push_back({var, coef});
-    }
-    std::erase_if(rows[d].entries, [](const auto& p) { return p.second == 0.0; });
-  }
+  for (int d = 0; d < 2; ++d)
+    rows[d] = make_row({{2 * c.b1 + d, 1.0},
+                        {2 * c.b0 + d, -1.0},
+                        {2 * c.a1 + kRotationSource[r][d], -kRotationSign[r][d]},
+                        {2 * c.a0 + kRotationSource[r][d], kRotationSign[r][d]}});
   return rows;
 }
 

@@ -59,6 +59,13 @@ std::vector<double> measure_matchings(const CutMesh& cut, const Eigen::MatrixX2d
 struct SparseRow {
   std::vector<std::pair<int, double>> entries;
 };
+// A row from (variable, coefficient) terms: sorted by variable, equal variables summed, zero
+// coefficients dropped.
+SparseRow make_row(std::vector<std::pair<int, double>> terms);
+// The rotation by r quarter turns (r in 0..3) on the coordinates:
+// (R^r e)[d] = kRotationSign[r][d] · e[kRotationSource[r][d]].
+inline constexpr int kRotationSource[4][2] = {{0, 1}, {1, 0}, {0, 1}, {1, 0}};
+inline constexpr double kRotationSign[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
 std::array<SparseRow, 2> seam_constraint_rows(const CutMesh& cut, int seam, int matching);
 
 // 3D length of the edge of seam s.

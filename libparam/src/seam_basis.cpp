@@ -8,10 +8,6 @@
 namespace quadify::param {
 namespace {
 
-// (R^r e)[d] = kSign[r][d] · e[kSrc[r][d]].
-constexpr int kSrc[4][2] = {{0, 1}, {1, 0}, {0, 1}, {1, 0}};
-constexpr double kSign[4][2] = {{1, 1}, {-1, 1}, {-1, -1}, {1, -1}};
-
 // Pivot priorities: copies first, then the translation each closed vertex is solved for, and
 // the translations meant to stay free last.
 constexpr int kCopyPriority = 3, kTreeTranslationPriority = 2, kFreeTranslationPriority = 1;
@@ -21,19 +17,10 @@ int quarter_turns(int matching) { return ((matching % 4) + 4) % 4; }
 // Rows x_b − R^r x_a − t = 0 of one end (copies a, b of one vertex; a == b at a leaf of the cut).
 std::array<SparseRow, 2> end_rows(const CutMesh& cut, int seam, int r, int a, int b) {
   std::array<SparseRow, 2> rows;
-  for (int d = 0; d < 2; ++d) {
-    std::vector<std::pair<int, double>> e = {{2 * b + d, 1.0},
-                                             {2 * a + kSrc[r][d], -kSign[r][d]},
-                                             {seam_translation_var(cut, seam, d), -1.0}};
-    std::sort(e.begin(), e.end());
-    for (const auto& [var, coef] : e) {
-      if (!rows[d].entries.empty() && rows[d].entries.back().first == var)
-        rows[d].entries.back().second += coef;
-      else
-        rows[d].entries.push_back({var, coef});
-    }
-    std::erase_if(rows[d].entries, [](const auto& p) { return p.second == 0.0; });
-  }
+  for (int d = 0; d < 2; ++d)
+    rows[d] = make_row({{2 * b + d, 1.0},
+                        {2 * a + kRotationSource[r][d], -kRotationSign[r][d]},
+                        {seam_translation_var(cut, seam, d), -1.0}});
   return rows;
 }
 

@@ -69,11 +69,7 @@ TEST(CutLayout, MatchingOfAFlatSquareIsZeroAndOfACubeCornerIsAQuarter) {
   const auto m = measure_matchings(cut, isometric_unfold(flat, cut));
   for (double v : m) EXPECT_NEAR(v, 0.0, 1e-12) << "flat disk seams are untwisted";
   // The three faces around a cube corner: angle defect π/2, so the one seam matches ±1.
-  core::TriMesh corner;
-  corner.V.resize(4, 3);
-  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  corner.F.resize(3, 3);
-  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const core::TriMesh corner = test::make_cube_corner();
   const CutMesh cc = cut_along_dual_tree(corner, 0);
   ASSERT_EQ(cc.seams.size(), 1u);
   const auto mc = measure_matchings(cc, isometric_unfold(corner, cc));
@@ -202,11 +198,7 @@ TEST(SeamBasis, SameSpaceAsCopiesOnlyExactAndLocal) {
 // At a cube corner the root face's first vertex is a cone, whose copy the elimination solves for:
 // the gauge moves to a copy of another vertex and the space stays the copies-only one.
 TEST(SeamBasis, GaugeLeavesAConeAtTheRoot) {
-  core::TriMesh corner;
-  corner.V.resize(4, 3);
-  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  corner.F.resize(3, 3);
-  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const core::TriMesh corner = test::make_cube_corner();
   const CutMesh cut = cut_along_dual_tree(corner, 0);
   ASSERT_EQ(cut.seams.size(), 1u);
   ASSERT_EQ(cut.copy_vertex[cut.root_copy], 0);
@@ -352,11 +344,7 @@ TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
   // is ambiguous is not needed: ask for a choice given a measure of 0.5 (between 0 and 1 in the
   // direction of the true rotation); the side equal to the true rotation yields a flat, lower
   // distortion patch.
-  core::TriMesh corner;
-  corner.V.resize(4, 3);
-  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  corner.F.resize(3, 3);
-  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  const core::TriMesh corner = test::make_cube_corner();
   const CutMesh cut = cut_along_dual_tree(corner, 0);
   const LayoutDomain dom = make_domain(cut);
   const Eigen::VectorXd x = flatten(isometric_unfold(corner, cut));

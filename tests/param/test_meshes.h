@@ -73,6 +73,16 @@ inline core::TriMesh make_torus(int n, int m, double R = 2.0, double r = 0.7) {
 }
 
 // A curved open disk: a polar grid (rings × sectors) lifted onto a paraboloid.
+// Three faces of a cube meeting at the origin (angle defect π/2 at vertex 0), open.
+inline core::TriMesh make_cube_corner() {
+  core::TriMesh corner;
+  corner.V.resize(4, 3);
+  corner.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  corner.F.resize(3, 3);
+  corner.F << 0, 2, 1, 0, 3, 2, 0, 1, 3;
+  return corner;
+}
+
 inline core::TriMesh make_disk(int rings, int sectors) {
   core::TriMesh d;
   d.V.resize(1 + rings * sectors, 3);
