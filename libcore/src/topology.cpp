@@ -169,4 +169,96 @@ std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, doub
   return sharp;
 }
 
+std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, const CreaseOptions& options) {
+  std::vector<int> sharp = sharp_edges(mesh, topo, options.angle_deg);
+  if (!(options.max_side_angle_deg > 0) || sharp.empty()) return sharp;
+  const int ne = topo.n_edges(), nv = mesh.n_vertices();
+  // Dihedral angle (degrees) of every interior edge; 0 where a face is degenerate.
+  std::vector<double> dihedral(ne, 0);
+  auto normal = [&](int f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                          c = mesh.V.row(mesh.F(f, 2));
+    return Eigen::Vector3d((b - a).cross(c - a));
+  };
+  for (int e = 0; e < ne; ++e) {
+    const int h = topo.edge_halfedge[e], t = topo.twin[h];
+    if (t < 0) continue;
+    const Eigen::Vector3d n0 = normal(h / 3), n1 = normal(t / 3);
+    const double len = n0.norm() * n1.norm();
+    if (len > 0) dihedral[e] = std::acos(std::clamp(n0.dot(n1) / len, -1.0, 1.0)) * 180 / std::numbers::pi;
+  }
+  std::vector<char> is_sharp(ne, 0);
+  for (const int e : sharp) is_sharp[e] = 1;
+  auto side_angle = [&](int e) {
+    double m = 0;
+    const int h = topo.edge_halfedge[e];
+    for (const int he : {h, topo.twin[h]}) {
+      if (he < 0) continue;
+      for (int k = 0; k < 3; ++k) {
+        const int o = topo.face_edge(he / 3, k);
+        if (o != e && !is_sharp[o]) m = std::max(m, dihedral[o]);
+      }
+    }
+    return m;
+  };
+  // Sharp edges at each vertex (CSR).
+  std::vector<int> start(nv + 1, 0), at;
+  for (const int e : sharp) {
+    ++start[topo.edge_vertex(e, 0) + 1];
+    ++start[topo.edge_vertex(e, 1) + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  at.resize(start[nv]);
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (const int e : sharp) {
+      at[fill[topo.edge_vertex(e, 0)]++] = e;
+      at[fill[topo.edge_vertex(e, 1)]++] = e;
+    }
+  }
+  auto degree = [&](int v) { return start[v + 1] - start[v]; };
+  auto other = [&](int e, int v) { return topo.edge_vertex(e, 0) == v ? topo.edge_vertex(e, 1) : topo.edge_vertex(e, 0); };
+  // Chains: maximal paths through vertices with exactly two sharp edges (or closed loops).
+  std::vector<char> seen(ne, 0), keep(ne, 0);
+  std::vector<int> chain;
+  std::vector<double> sides;
+  for (const int e0 : sharp) {
+    if (seen[e0]) continue;
+    chain.assign(1, e0);
+    seen[e0] = 1;
+    for (int end = 0; end < 2; ++end) {
+      int e = e0, v = topo.edge_vertex(e0, end);
+      while (degree(v) == 2) {
+        const int next = at[start[v]] == e ? at[start[v] + 1] : at[start[v]];
+        if (seen[next]) break;
+        seen[next] = 1;
+        chain.push_back(next);
+        e = next;
+        v = other(e, v);
+      }
+    }
+    sides.clear();
+    for (const int e : chain) sides.push_back(side_angle(e));
+    std::nth_element(sides.begin(), sides.begin() + sides.size() / 2, sides.end());
+    if (sides[sides.size() / 2] < options.max_side_angle_deg)
+      for (const int e : chain) keep[e] = 1;
+  }
+  // Groups of kept edges connected through vertices; small ones are dropped.
+  std::vector<int> parent(nv);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const int e : sharp)
+    if (keep[e]) parent[find(topo.edge_vertex(e, 0))] = find(topo.edge_vertex(e, 1));
+  std::vector<int> group_edges(nv, 0);
+  for (const int e : sharp)
+    if (keep[e]) ++group_edges[find(topo.edge_vertex(e, 0))];
+  std::vector<int> creases;
+  for (const int e : sharp)
+    if (keep[e] && group_edges[find(topo.edge_vertex(e, 0))] >= options.min_group_edges) creases.push_back(e);
+  return creases;
+}
+
 }  // namespace quadify::core

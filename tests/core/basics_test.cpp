@@ -6,12 +6,14 @@
 #include <libcore/atomic_file.h>
 #include <libcore/mesh.h>
 #include <libcore/predicates.h>
+#include <libcore/read_mesh.h>
 #include <libcore/sparse_solver.h>
 #include <libcore/status.h>
 #include <libcore/topology.h>
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -190,6 +192,39 @@ TEST(TopologyTest, NonManifoldInputIsCountedOrRejected) {
 }
 
 // --- predicates.h ---
+
+TriMesh load_data_mesh(const std::string& name) { return to_trimesh(read_mesh(test::data_path(name))); }
+
+TEST(TopologyTest, CreasesOfACadBoxAreAllItsSharpEdges) {
+  const TriMesh box = load_data_mesh("box.obj");
+  const EdgeTopology topo = build_edge_topology(box);
+  const std::vector<int> sharp = sharp_edges(box, topo, 40);
+  ASSERT_EQ(sharp.size(), 72u) << "the box's 12 edges of 4–8 mesh edges each";
+  EXPECT_EQ(crease_edges(box, topo, CreaseOptions{}), sharp) << "flat sides: every sharp edge is a crease";
+  const TriMesh cube = load_data_mesh("cube.obj");
+  const EdgeTopology cube_topo = build_edge_topology(cube);
+  EXPECT_EQ(crease_edges(cube, cube_topo, CreaseOptions{}).size(), 12u) << "12 triangles, 12 creases";
+}
+
+TEST(TopologyTest, CreaseFilterLeavesOutTheSharpEdgesOfAnOrganicMesh) {
+  const TriMesh spot = load_data_mesh("spot.obj");
+  const EdgeTopology topo = build_edge_topology(spot);
+  const std::vector<int> sharp = sharp_edges(spot, topo, 40);
+  CreaseOptions off;
+  off.max_side_angle_deg = 0;
+  EXPECT_EQ(crease_edges(spot, topo, off), sharp) << "0 turns the filter off";
+  const std::vector<int> creases = crease_edges(spot, topo, CreaseOptions{});
+  // spot's 73 sharp edges are mostly single edges at its coarsely tessellated ears, horns and
+  // hooves, where the sides are curved too; what stays is one group of ≥ 6 creases.
+  EXPECT_EQ(sharp.size(), 73u);
+  EXPECT_GE(creases.size(), 6u);
+  EXPECT_LE(creases.size(), 20u);
+  EXPECT_TRUE(std::includes(sharp.begin(), sharp.end(), creases.begin(), creases.end()))
+      << "creases are sharp edges, in increasing order";
+  CreaseOptions strict;
+  strict.max_side_angle_deg = 1;
+  EXPECT_TRUE(crease_edges(spot, topo, strict).empty()) << "no sharp edge of spot has flat sides";
+}
 
 TEST(PredicatesTest, Orient2dSignsAndExactness) {
   EXPECT_EQ(orient2d({0, 0}, {1, 0}, {0, 1}), 1);

@@ -87,6 +87,14 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
                  "detected features")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));
+  app.add_option("--feature-side-angle", a->side_angle_deg,
+                 "Keep only sharp edges that are creases between two smooth sides: a chain of sharp "
+                 "edges is dropped when the median, over its edges, of the largest dihedral angle of "
+                 "the other edges of their faces is at least this (degrees), and so are groups of "
+                 "fewer than 6 sharp edges; this leaves out the sharp edges of scans and sculpts "
+                 "(coarsely tessellated tips, folds and crevices); 0 = every sharp edge")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 180.0));
   app.add_option("--feature-edges", a->edge_file,
                  "Extra feature edges: a text file with one pair 'a b' of 0-based input vertex ids per "
                  "line ('#' starts a comment)")
@@ -118,10 +126,15 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   options->feature_max_tau = args.max_tau;
   options->feature_max_wedge_stretch = args.max_wedge_stretch;
   options->feature_edges.clear();
-  if (args.angle_deg > 0)
-    for (const int e : core::sharp_edges(mesh, topo, args.angle_deg))
+  if (args.angle_deg > 0) {
+    core::CreaseOptions crease;
+    crease.angle_deg = args.angle_deg;
+    crease.max_side_angle_deg = args.side_angle_deg;
+    fi.n_detected = static_cast<int>(core::sharp_edges(mesh, topo, args.angle_deg).size());
+    for (const int e : core::crease_edges(mesh, topo, crease))
       options->feature_edges.push_back({topo.edge_vertex(e, 0), topo.edge_vertex(e, 1)});
-  fi.n_detected = static_cast<int>(options->feature_edges.size());
+    fi.n_not_creases = fi.n_detected - static_cast<int>(options->feature_edges.size());
+  }
   // Given edges in input vertex ids, with where they came from.
   struct Given {
     int a, b;
@@ -202,6 +215,7 @@ void warn_feature_fallbacks(const std::string& input, const param::ParamStats& s
 
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
   return {{"detected_sharp_edges", fi.n_detected},
+          {"sharp_edges_not_creases", fi.n_not_creases},
           {"given_edges", fi.n_given},
           {"given_edges_lost_in_repair", fi.n_lost},
           {"too_small_for_density", fi.n_too_small},

@@ -85,6 +85,7 @@ LoadedMesh load_and_repair(const std::filesystem::path& path, Progress& progress
 // Feature alignment options shared by `param` and the remesher.
 struct FeatureArgs {
   double angle_deg = 40;     // --feature-angle: sharp edges above this dihedral angle; 0 = none
+  double side_angle_deg = 15;  // --feature-side-angle: crease filter (core::CreaseOptions); 0 = off
   std::string edge_file;     // --feature-edges FILE: lines "a b" of input vertex ids (0-based)
   bool from_obj_lines = true;  // OBJ `l` lines of the input are feature edges too
   bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
@@ -100,6 +101,7 @@ void warn_feature_fallbacks(const std::string& input, const param::ParamStats& s
 // the file for an unreadable edge file or an edge that is not an edge of the input.
 struct FeatureInput {
   int n_detected = 0;  // sharp edges found by the dihedral angle
+  int n_not_creases = 0;  // of those, left out by the crease filter (no smooth sides, fragments)
   int n_given = 0;     // edges from the file and the OBJ lines
   int n_lost = 0;      // given edges that the repair removed (e.g. with a degenerate face)
   int n_too_small = 0;  // edges of curves too short for the quad density (remesh only)

@@ -51,6 +51,23 @@ int face_components(const TriMesh& mesh, const EdgeTopology& topo, std::vector<i
 // sharp edge (their normal is undefined).
 std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, double angle_deg);
 
+// Which sharp edges are design creases (feature lines to align) rather than curvature that the
+// tessellation resolves coarsely (scans, sculpts: thin parts, tips, crevices).
+struct CreaseOptions {
+  double angle_deg = 40;  // an edge is sharp above this dihedral angle (degrees)
+  // A crease separates two locally smooth sides. An edge's side angle is the largest dihedral
+  // angle among the other, non-sharp edges of its two faces; a feature chain (sharp edges between
+  // vertices where the sharp edges do not simply continue) is kept when the median side angle of
+  // its edges is below this (degrees). 0 keeps every sharp edge (no filtering).
+  double max_side_angle_deg = 15;
+  // Connected groups of kept sharp edges with fewer edges than this are dropped (isolated
+  // fragments); applies only when max_side_angle_deg > 0.
+  int min_group_edges = 6;
+};
+
+// Sharp edges (as sharp_edges) that pass the crease filter of `options`, in increasing order.
+std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, const CreaseOptions& options);
+
 // Topological statistics of any triangle mesh (also non-manifold ones: counts only).
 TopologyStats topology_stats(const TriMesh& mesh);
 
