@@ -10,6 +10,10 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libopenmesh-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libtinygltf-dev libstb-dev libsuitesparse-dev libtbb-dev
+  # An optimized, thread-safe BLAS/LAPACK for CHOLMOD's supernodal factorization (Debian's
+  # alternatives then point libblas.so.3 at it): armadillo's factorizations 60.6 s → 39.8 s
+  # against the reference BLAS. Not the serial OpenBLAS, which is unsafe for concurrent calls.
+  libopenblas0-pthread
   libgtest-dev libcli11-dev nlohmann-json3-dev
 )
 with_test_tools=0
