@@ -50,6 +50,9 @@ constexpr double kTauPowers[] = {2, 4, 8, 16, 32, 64};
 // Newton iterations per continuation stage: each stage only needs to move the maximum, and
 // the stages follow each other closely.
 constexpr int kTauStageIterations = 15;
+// Newton-decrement stop of the intermediate stages: each only hands its layout to the next
+// exponent; the last stage converges to kFinalTolerance.
+constexpr double kTauStageTolerance = 1e-5;
 
 struct ComponentOutput {
   core::Status status;
@@ -425,7 +428,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.density = Density::kPowerSD;
       st.power = p;
       st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
-      st.relative_tolerance = kFinalTolerance;
+      st.relative_tolerance = p == std::end(kTauPowers)[-1] ? kFinalTolerance : kTauStageTolerance;
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
