@@ -243,21 +243,34 @@ std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, con
     if (sides[sides.size() / 2] < options.max_side_angle_deg)
       for (const int e : chain) keep[e] = 1;
   }
-  // Groups of kept edges connected through vertices; small ones are dropped.
+  // Groups of sharp edges connected through vertices: a group made mostly of crease chains is
+  // kept whole (a CAD crease network whose chains partly run along curved fillets), elsewhere only
+  // the crease chains stay. Then groups of kept edges that are too small are dropped.
   std::vector<int> parent(nv);
-  std::iota(parent.begin(), parent.end(), 0);
   auto find = [&](int v) {
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
+  auto group_sizes = [&](const std::vector<char>& in, std::vector<int>* size) {
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const int e : sharp)
+      if (in[e]) parent[find(topo.edge_vertex(e, 0))] = find(topo.edge_vertex(e, 1));
+    size->assign(nv, 0);
+    for (const int e : sharp)
+      if (in[e]) ++(*size)[find(topo.edge_vertex(e, 0))];
+  };
+  std::vector<int> n_all, n_kept(nv, 0);
+  group_sizes(is_sharp, &n_all);
   for (const int e : sharp)
-    if (keep[e]) parent[find(topo.edge_vertex(e, 0))] = find(topo.edge_vertex(e, 1));
-  std::vector<int> group_edges(nv, 0);
-  for (const int e : sharp)
-    if (keep[e]) ++group_edges[find(topo.edge_vertex(e, 0))];
+    if (keep[e]) ++n_kept[find(topo.edge_vertex(e, 0))];
+  for (const int e : sharp) {
+    const int g = find(topo.edge_vertex(e, 0));
+    if (2 * n_kept[g] >= n_all[g]) keep[e] = 1;
+  }
+  group_sizes(keep, &n_kept);
   std::vector<int> creases;
   for (const int e : sharp)
-    if (keep[e] && group_edges[find(topo.edge_vertex(e, 0))] >= options.min_group_edges) creases.push_back(e);
+    if (keep[e] && n_kept[find(topo.edge_vertex(e, 0))] >= options.min_group_edges) creases.push_back(e);
   return creases;
 }
 

@@ -57,8 +57,10 @@ struct CreaseOptions {
   double angle_deg = 40;  // an edge is sharp above this dihedral angle (degrees)
   // A crease separates two locally smooth sides. An edge's side angle is the largest dihedral
   // angle among the other, non-sharp edges of its two faces; a feature chain (sharp edges between
-  // vertices where the sharp edges do not simply continue) is kept when the median side angle of
-  // its edges is below this (degrees). 0 keeps every sharp edge (no filtering).
+  // vertices where the sharp edges do not simply continue) is a crease chain when the median side
+  // angle of its edges is below this (degrees). A connected group of sharp edges made at least
+  // half of crease chains is kept whole; elsewhere only the crease chains are kept. 0 keeps every
+  // sharp edge (no filtering).
   double max_side_angle_deg = 15;
   // Connected groups of kept sharp edges with fewer edges than this are dropped (isolated
   // fragments); applies only when max_side_angle_deg > 0.
