@@ -1,5 +1,6 @@
-// The one sparse SPD solver wrapper: CHOLMOD (supernodal LLT) when built with it, else Eigen's
-// SimplicialLDLT. Analyse a pattern once, factorize many times, solve many times.
+// The one sparse SPD solver wrapper: CHOLMOD (supernodal LLT) for large systems when built with it,
+// Eigen's SimplicialLLT for small ones (and without CHOLMOD). Analyse a pattern once, factorize
+// many times, solve many times.
 #pragma once
 
 #include <libcore/status.h>
@@ -27,7 +28,7 @@ class SparseSolver {
   // Solves A x = b with the last factorization. b: n×k.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
   bool factorized() const;
-  // "cholmod" or "eigen-ldlt".
+  // The backend of large systems: "cholmod" or "eigen-llt".
   static const char* backend();
 
  private:
