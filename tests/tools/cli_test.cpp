@@ -258,11 +258,45 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
   EXPECT_EQ(report["param"]["features"]["detected_sharp_edges"], 72);
+  EXPECT_EQ(report["param"]["features"]["sharp_edges_not_creases"], 0) << "flat sides: all creases";
   EXPECT_EQ(report["param"]["features"]["aligned"], 72);
   EXPECT_EQ(report["quantize"]["features_dropped"], false);
   EXPECT_GE(report["quads"]["feature_capture"].get<double>(), 0.999);
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
   EXPECT_EQ(report["quads"]["non_quads"], 0);
+}
+
+// A component smaller than a quad (a 2 cm flake beside a torus remeshed at 400 quads) gets no
+// quad; the remesher says so on stderr and in the report instead of dropping it silently.
+TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
+  std::ostringstream obj;
+  obj << slurp(data_path("torus.obj"));
+  int nv = 0;
+  {
+    std::istringstream in(slurp(data_path("torus.obj")));
+    for (std::string line; std::getline(in, line);)
+      if (line.rfind("v ", 0) == 0) ++nv;
+  }
+  obj << "\n";
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) obj << "v " << 10 + 0.01 * i << " " << 0.01 * j << " 0\n";
+  for (int j = 0; j < 2; ++j)
+    for (int i = 0; i < 2; ++i) {
+      const int a = nv + 1 + 3 * j + i, b = a + 1, c = a + 3, d = c + 1;
+      obj << "f " << a << " " << b << " " << d << "\nf " << a << " " << d << " " << c << "\n";
+    }
+  const fs::path in = dir_ / "torus_flake.obj";
+  write_text(in, obj.str());
+  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
+  args.append("'").append(in.string()).append("' -o '").append((dir_ / "o.obj").string());
+  args.append("' --target-faces 400 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 of 2 components got no quads"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["mesh"]["components"], 2);
+  EXPECT_EQ(report["quads"]["components"], 1);
+  EXPECT_EQ(report["quads"]["components_lost"], 1);
 }
 
 // A feature-edge file with a malformed line or a pair that is not an edge is bad input, named.

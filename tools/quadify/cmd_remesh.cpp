@@ -201,6 +201,17 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"mean_dist_sym", number(m.mean_dist_sym)},
                        {"feature_capture", m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json()},
                        {"feature_hausdorff", m.feature_capture >= 0 ? number(m.feature_hausdorff) : nlohmann::json()}};
+    // A component smaller than about one quad gets no grid point inside and so no quad: say so
+    // rather than let a part of the model vanish silently.
+    const int input_components = core::topology_stats(mesh).n_components;
+    const int lost = std::max(0, input_components - m.n_components);
+    report["quads"]["components_lost"] = lost;
+    if (lost > 0 && !common.quiet)
+      std::fprintf(stderr,
+                   "quadify: warning: %s: %d of %d components got no quads (smaller than about one "
+                   "quad at this density; a larger --target-faces or a smaller --edge-length keeps "
+                   "them)\n",
+                   args.input.c_str(), lost, input_components);
     if (!common.quiet)
       std::printf("%s -> %s: %d faces (%d not quads), %d irregular vertices, %d flipped, Hausdorff %.3g of the "
                   "diagonal\n",
