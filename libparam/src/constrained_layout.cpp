@@ -199,6 +199,7 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   const int n_ext = 2 * n + 2 * n_seams;
   if (static_cast<int>(copies.corner_copy.size()) != 3 * nf ||
       (x0.size() != 2 * n && x0.size() != n_ext) || !(options.rest_scale > 0) ||
+      (!options.face_size.empty() && static_cast<int>(options.face_size.size()) != nf) ||
       (!options.gauge_copies.empty() &&
        static_cast<int>(options.gauge_copies.size()) != copies.n_components)) {
     res.status = core::Status::invalid_input("solve_constrained_layout: sizes do not match");
@@ -236,7 +237,8 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
       domain.face_copies[f][k] = x_base / 2 + copies.corner_copy[3 * f + k];
     const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
                           p2 = mesh.V.row(mesh.F(f, 2));
-    const Eigen::Vector3d e1 = (p1 - p0) * options.rest_scale, e2 = (p2 - p0) * options.rest_scale;
+    const double rs = options.face_size.empty() ? options.rest_scale : options.rest_scale / options.face_size[f];
+    const Eigen::Vector3d e1 = (p1 - p0) * rs, e2 = (p2 - p0) * rs;
     const double l1 = e1.norm();
     Eigen::Matrix2d dm;
     dm << l1, e1.dot(e2) / l1, 0, e1.cross(e2).norm() / l1;
@@ -582,6 +584,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   const int n_seams = static_cast<int>(copies.seams.size());
   if (static_cast<int>(copies.corner_copy.size()) != 3 * nf || x0.size() < 2 * n ||
       !(options.rest_scale > 0) ||
+      (!options.face_size.empty() && static_cast<int>(options.face_size.size()) != nf) ||
       (!options.prefer_free.empty() && static_cast<int>(options.prefer_free.size()) != n) ||
       (!options.gauge_copies.empty() &&
        static_cast<int>(options.gauge_copies.size()) != copies.n_components))
@@ -612,7 +615,8 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
     for (int k = 0; k < 3; ++k) m.domain.face_copies[f][k] = copy_slot[copies.corner_copy[3 * f + k]];
     const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
                           p2 = mesh.V.row(mesh.F(f, 2));
-    const Eigen::Vector3d e1 = (p1 - p0) * options.rest_scale, e2 = (p2 - p0) * options.rest_scale;
+    const double rs = options.face_size.empty() ? options.rest_scale : options.rest_scale / options.face_size[f];
+    const Eigen::Vector3d e1 = (p1 - p0) * rs, e2 = (p2 - p0) * rs;
     const double l1 = e1.norm();
     Eigen::Matrix2d dm;
     dm << l1, e1.dot(e2) / l1, 0, e1.cross(e2).norm() / l1;

@@ -23,7 +23,8 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 
 }  // namespace
 
-CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face) {
+CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face,
+                            const std::vector<double>& face_size) {
   CutMesh cut;
   const int nf = mesh.n_faces();
   cut.topo = core::build_edge_topology(mesh);
@@ -97,7 +98,12 @@ CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face) {
     dm << l1, e1.dot(e2) / l1, 0.0, cr / l1;
     cut.rest[f] = dm;
     cut.area[f] = 0.5 * cr;
+    if (!face_size.empty()) {
+      cut.rest[f] /= face_size[f];
+      cut.area[f] /= face_size[f] * face_size[f];
+    }
   }
+  cut.sized = !face_size.empty();
   return cut;
 }
 
@@ -114,12 +120,13 @@ Eigen::MatrixX2d isometric_unfold(const core::TriMesh& mesh, const CutMesh& cut)
       for (int k = 0; k < 3; ++k) x.row(cc[3 * f + k]) = q[k].transpose();
       continue;
     }
-    // Rigid motion mapping the rest edge k→k+1 onto the placed shared edge.
+    // Rigid motion (similarity with a size field) mapping the rest edge k→k+1 onto the placed
+    // shared edge.
     const int k = cut.topo.twin[hp] % 3, k1 = (k + 1) % 3, k2 = (k + 2) % 3;
     const Eigen::Vector2d xa = x.row(cc[3 * f + k]).transpose();
     const Eigen::Vector2d xb = x.row(cc[3 * f + k1]).transpose();
     const Eigen::Vector2d a = q[k1] - q[k], b = xb - xa;
-    const double inv = 1.0 / (a.norm() * b.norm());
+    const double inv = cut.sized ? 1.0 / a.squaredNorm() : 1.0 / (a.norm() * b.norm());
     const double c = a.dot(b) * inv, s = cross2(a, b) * inv;
     const Eigen::Vector2d d = q[k2] - q[k];
     x.row(cc[3 * f + k2]) = (xa + Eigen::Vector2d(c * d.x() - s * d.y(), s * d.x() + c * d.y()))

@@ -32,16 +32,23 @@ struct CutMesh {
   int root_copy = 0;                      // a copy of the root face, kept fixed (translation gauge)
   // Rest shape of each face in an isometric 2D frame of its 3D triangle: the 2×2 matrix
   // Dm = [p1−p0, p2−p0] with p0 = 0 and p1 on the positive x axis.
+  // With a size field (cut_along_dual_tree's face_size) the frame is that of the triangle scaled
+  // by 1/size: the target shape of the face in the map (paper section 7).
   std::vector<Eigen::Matrix2d> rest;      // #F
-  std::vector<double> area;               // #F, 3D area
+  std::vector<double> area;               // #F, area of the rest shape
+  bool sized = false;                     // rest shapes of different scales (a size field)
 };
 
 // Cuts a connected, manifold, consistently oriented mesh along a BFS dual spanning tree rooted at
 // face `seed_face`. Vertex copies are the corners merged across the tree edges (in BFS order, so
-// copy ids grow away from the root).
-CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face = 0);
+// copy ids grow away from the root). face_size (#F positive values, or empty): the target edge
+// length of each face relative to its 3D size; rest frames are the triangles scaled by 1/size.
+CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face = 0,
+                            const std::vector<double>& face_size = {});
 
-// Isometric layout of the cut mesh, face by face in BFS order: (#copies)×2 positions.
+// Isometric layout of the cut mesh, face by face in BFS order: (#copies)×2 positions. With a size
+// field (cut.sized) each face is placed by the similarity that maps its rest edge onto the edge
+// already placed (conforming, with the scale changing from face to face).
 Eigen::MatrixX2d isometric_unfold(const core::TriMesh& mesh, const CutMesh& cut);
 
 // The vertex copies at the ends of seam s: v0 and v1 in face a (a0, a1) and in face b (b0, b1).

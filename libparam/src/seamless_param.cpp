@@ -84,10 +84,11 @@ double batch_threshold(const ParamOptions& o, int i) {
 
 // feature_edges: component-local vertex pairs of feature edges (edges of `mesh`).
 ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options,
-                              const std::vector<std::array<int, 2>>& feature_edges) {
+                              const std::vector<std::array<int, 2>>& feature_edges,
+                              const std::vector<double>& face_size) {
   ComponentOutput out;
   const auto t0 = Clock::now();
-  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0, face_size);
   const LayoutDomain domain = make_domain(cut);
   // x: the copies' UVs and the seam translations (seam_basis.h); the energy reads the copies.
   const int n_copy_vars = 2 * cut.n_copies();
@@ -509,6 +510,14 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   if (!(o.feature_max_tau > 1) || !(o.feature_max_wedge_stretch >= 1))
     return core::Status::invalid_input("feature_max_tau must be > 1 and feature_max_wedge_stretch >= 1");
   if (mesh.n_faces() == 0) return core::Status::invalid_input("mesh has no faces");
+  if (!o.face_size.empty()) {
+    if (static_cast<int>(o.face_size.size()) != mesh.n_faces())
+      return core::Status::invalid_input("face_size has " + std::to_string(o.face_size.size()) +
+                                         " values for " + std::to_string(mesh.n_faces()) + " faces");
+    for (const double s : o.face_size)
+      if (!(s > 0) || !std::isfinite(s))
+        return core::Status::invalid_input("face_size values must be finite and positive");
+  }
   if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
   for (int f = 0; f < mesh.n_faces(); ++f) {
     for (int k = 0; k < 3; ++k)
@@ -580,6 +589,10 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
       sub_features[c].push_back({local_vertex[a], local_vertex[b]});
     }
   }
+  std::vector<std::vector<double>> sub_size(n_comp);
+  if (!options.face_size.empty())
+    for (int c = 0; c < n_comp; ++c)
+      for (const int f : sub_faces[c]) sub_size[c].push_back(options.face_size[f]);
   std::vector<ComponentOutput> outs(n_comp);
   // Components may run on worker threads: serialize the progress callback.
   ParamOptions component_options = options;
@@ -596,12 +609,12 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   plain_options.align_boundaries = false;
   std::vector<char> fell_back(n_comp, 0);
   auto work = [&](int c) {
-    outs[c] = run_component(sub[c], component_options, sub_features[c]);
+    outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c]);
     if (outs[c].status.is_ok() || outs[c].status.code() == core::StatusCode::kInvalidInput ||
         outs[c].stats.n_feature_edges == 0)
       return;
     const int n_features = outs[c].stats.n_feature_edges;
-    outs[c] = run_component(sub[c], plain_options, {});
+    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c]);
     outs[c].stats.n_feature_edges = n_features;
     outs[c].stats.n_disabled_features = n_features;
     fell_back[c] = 1;

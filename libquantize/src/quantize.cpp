@@ -687,7 +687,20 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   st.n_candidates = static_cast<int>(candidates.size());
 
   // Scale.
-  const double area3d = surface_area(mesh);
+  double area3d = surface_area(mesh);
+  if (!options.face_size.empty()) {
+    if (static_cast<int>(options.face_size.size()) != nf) {
+      out.status = core::Status::invalid_input("face_size has " + std::to_string(options.face_size.size()) +
+                                               " values for " + std::to_string(nf) + " faces");
+      return out;
+    }
+    area3d = 0;
+    for (int f = 0; f < nf; ++f) {
+      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                            p2 = mesh.V.row(mesh.F(f, 2));
+      area3d += 0.5 * (p1 - p0).cross(p2 - p0).norm() / (options.face_size[f] * options.face_size[f]);
+    }
+  }
   const double area_uv = uv_area(cl, cl.x, nf);
   double scale = 0;
   if (options.target_faces > 0) {
@@ -705,6 +718,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
 
   param::PinnedLayoutOptions lopt;
   lopt.energy = options.energy;
+  lopt.face_size = options.face_size;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
   std::vector<char> feature_coords;

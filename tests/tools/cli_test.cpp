@@ -2,6 +2,7 @@
 // partial output on failure.
 #include "cli_run.h"
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -11,6 +12,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 
 namespace fs = std::filesystem;
@@ -297,6 +299,97 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
   EXPECT_EQ(report["mesh"]["components"], 2);
   EXPECT_EQ(report["quads"]["components"], 1);
   EXPECT_EQ(report["quads"]["components_lost"], 1);
+}
+
+// --adaptive: on an ellipsoid (3, 1, 1) the quads at the tips (curvature 3) come out smaller
+// than around the middle (curvature 1), more so than the map's own distortion makes them.
+TEST_F(CliTest, AdaptiveSizingMakesSmallerQuadsWhereTheSurfaceBendsMore) {
+  std::ostringstream obj;
+  {
+    std::istringstream in(slurp(data_path("sphere.obj")));
+    for (std::string line; std::getline(in, line);) {
+      if (line.rfind("v ", 0) == 0) {
+        std::istringstream ls(line.substr(2));
+        double x = 0, y = 0, z = 0;
+        ls >> x >> y >> z;
+        obj << "v " << 3 * x << " " << y << " " << z << "\n";
+      } else if (line.rfind("f ", 0) == 0) {
+        obj << line << "\n";
+      }
+    }
+  }
+  const fs::path in = dir_ / "ellipsoid.obj";
+  write_text(in, obj.str());
+  auto tip_over_middle = [&](const std::string& extra) {
+    const fs::path out = dir_ / "q.obj";
+    std::string args;
+    args.append("'").append(in.string()).append("' -o '").append(out.string());
+    args.append("' --target-faces 600 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
+    args.append(extra);
+    const CliRun r = quadify(args, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    EXPECT_EQ(report["quads"]["non_quads"], 0);
+    EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+    std::vector<Eigen::Vector3d> v;
+    double tip = 0, middle = 0;
+    int n_tip = 0, n_middle = 0;
+    std::istringstream qs(slurp(out));
+    for (std::string line; std::getline(qs, line);) {
+      std::istringstream ls(line.substr(std::min<size_t>(2, line.size())));
+      if (line.rfind("v ", 0) == 0) {
+        Eigen::Vector3d p;
+        ls >> p.x() >> p.y() >> p.z();
+        v.push_back(p);
+      } else if (line.rfind("f ", 0) == 0) {
+        std::vector<int> ids;
+        for (std::string t; ls >> t;) ids.push_back(std::stoi(t.substr(0, t.find('/'))) - 1);
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        double len = 0;
+        for (size_t i = 0; i < ids.size(); ++i) {
+          c += v[ids[i]] / static_cast<double>(ids.size());
+          len += (v[ids[i]] - v[ids[(i + 1) % ids.size()]]).norm() / static_cast<double>(ids.size());
+        }
+        if (std::abs(c.x()) > 2.5) tip += len, ++n_tip;
+        if (std::abs(c.x()) < 0.5) middle += len, ++n_middle;
+      }
+    }
+    EXPECT_GT(n_tip, 0);
+    EXPECT_GT(n_middle, 0);
+    return (tip / std::max(n_tip, 1)) / (middle / std::max(n_middle, 1));
+  };
+  const double uniform = tip_over_middle("");
+  const double adaptive = tip_over_middle("--adaptive");
+  EXPECT_LT(adaptive, uniform - 0.08) << "uniform " << uniform << ", adaptive " << adaptive;
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["param"]["sizing"]["mode"], "adaptive");
+  EXPECT_NEAR(report["quads"]["faces"].get<int>(), 600, 60) << "the count stays near the target";
+}
+
+// A size field file: one positive number per input vertex; a bad line or count is bad input.
+TEST_F(CliTest, SizeFieldFileIsReadOrRejectedNamingTheLine) {
+  const fs::path cube = dir_ / "cube.obj";
+  write_text(cube, kCubeTriObj);
+  auto run = [&](const std::string& sizes) {
+    write_text(dir_ / "sizes.txt", sizes);
+    std::string args;
+    args.append("'").append(cube.string()).append("' -o '").append((dir_ / "o.obj").string());
+    args.append("' --target-faces 24 --size-field '").append((dir_ / "sizes.txt").string()).append("'");
+    return quadify(args, dir_);
+  };
+  const CliRun word = run("1\n1\nbig\n");
+  EXPECT_EQ(word.exit_code, 2);
+  EXPECT_NE(word.err.find("sizes.txt: line 3"), std::string::npos) << word.err;
+  const CliRun negative = run("1\n-1\n");
+  EXPECT_EQ(negative.exit_code, 2);
+  EXPECT_NE(negative.err.find("line 2: sizes must be positive"), std::string::npos) << negative.err;
+  const CliRun count = run("1\n1\n1\n");
+  EXPECT_EQ(count.exit_code, 2);
+  EXPECT_NE(count.err.find("3 sizes for an input of 8 vertices"), std::string::npos) << count.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o.obj")) << "no output after bad input";
+  const CliRun ok = run("# sizes\n1\n1\n1\n1\n2\n2\n2\n2\n");
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(dir_ / "o.obj"));
 }
 
 // A feature-edge file with a malformed line or a pair that is not an edge is bad input, named.

@@ -19,6 +19,7 @@ struct ParamArgs {
   std::string output;
   param::ParamOptions options;
   FeatureArgs features;
+  SizingArgs sizing;
 };
 
 const std::map<std::string, param::RoundingOrder> kOrders = {
@@ -34,6 +35,8 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
   param::ParamOptions options = args.options;
   options.threads = common.threads;
   const FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &options);
+  SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
+  options.face_size = std::move(sizing.face_size);
   options.progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
   };
@@ -94,6 +97,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"sd_max", number(s.sd_max)},
                      {"seam_residual", number(s.seam_residual)},
                      {"features", feature_json(feature_input, s)},
+                     {"sizing", sizing.report},
                      {"seconds_cut", s.seconds_cut},
                      {"seconds_optimize", s.seconds_optimize},
                      {"seconds_local_estimation", s.seconds_local_estimation},
@@ -171,6 +175,7 @@ CommandRunner register_param(CLI::App& app) {
       ->check(CLI::Range(1, 10))
       ->capture_default_str();
   add_feature_options(app, &args->features);
+  add_sizing_options(app, &args->sizing);
   return [args](const CommonOptions& common) { return run_param(*args, common); };
 }
 

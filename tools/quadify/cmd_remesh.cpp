@@ -32,6 +32,7 @@ struct RemeshArgs {
   double cone_pair_distance = 4;  // × the target quad edge length
   double time_budget = 0;         // seconds for the quantization, 0 = none
   FeatureArgs features;
+  SizingArgs sizing;
 };
 
 
@@ -58,6 +59,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &param_options);
+  const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
+  param_options.face_size = sizing.face_size;
+  quantize_options.face_size = sizing.face_size;
   // Boundaries as explicit feature edges, so that curves too small for the density (tiny holes,
   // short creases) can be left unaligned.
   if (param_options.align_boundaries) {
@@ -152,6 +156,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                      {"cancelled_pairs", ps.n_cancelled_pairs},
                      {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
                      {"features", feature_json(feature_input, ps)},
+                     {"sizing", sizing.report},
                      {"seconds", ps.seconds_total}};
   const quantize::QuantizeStats& qs = integer_map.stats;
   report["quantize"] = {{"scale", qs.scale},          {"target_faces", args.target_faces},
@@ -271,6 +276,7 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::Range(1000, 10'000'000))
       ->capture_default_str();
   add_feature_options(app, &args->features);
+  add_sizing_options(app, &args->sizing);
   return [args](const CommonOptions& common) { return run_remesh(*args, common); };
 }
 

@@ -3,6 +3,7 @@
 #include <libcore/atomic_file.h>
 #include <libcore/read_mesh.h>
 #include <libcore/status.h>
+#include <libparam/sizing.h>
 
 #include <cstdio>
 #include <fstream>
@@ -282,6 +283,79 @@ void write_report(const CommonOptions& options, nlohmann::json report) {
   report["quadify_version"] = QUADIFY_VERSION;
   const std::string text = report.dump(2) + "\n";
   core::write_file_atomically(options.json_path, [&](std::ostream& out) { out << text; });
+}
+
+void add_sizing_options(CLI::App& app, SizingArgs* a) {
+  auto* adaptive = app.add_flag(
+      "--adaptive", a->adaptive,
+      "Curvature-adaptive quad sizes: edge length ∝ 1/sqrt(curvature) (even chordal error), "
+      "smaller quads where the surface bends more; the total stays near the target count");
+  app.add_option("--adaptive-ratio", a->max_ratio,
+                 "With --adaptive: largest over smallest quad edge length")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 100.0));
+  app.add_option("--size-field", a->size_file,
+                 "Relative quad edge length per input vertex: a text file of one positive number per "
+                 "line, in the input's vertex order ('#' starts a comment); only ratios matter")
+      ->type_name("FILE")
+      ->excludes(adaptive);
+}
+
+SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, Progress& progress) {
+  SizingInput out;
+  const core::TriMesh& mesh = loaded.repaired.mesh;
+  if (args.adaptive) {
+    progress.begin("sizing");
+    param::AdaptiveSizingOptions o;
+    o.max_ratio = args.max_ratio;
+    out.face_size = param::adaptive_face_size(mesh, o);
+    progress.end();
+    out.report["mode"] = "adaptive";
+    out.report["max_ratio"] = args.max_ratio;
+  } else if (!args.size_file.empty()) {
+    std::ifstream in(args.size_file);
+    if (!in) throw CliError{kExitBadInput, args.size_file + ": cannot read the size field"};
+    std::vector<double> input_size;
+    std::string line;
+    for (int ln = 1; std::getline(in, line); ++ln) {
+      if (const size_t hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+      std::istringstream ls(line);
+      double value = 0;
+      if (!(ls >> value)) {
+        std::string word;
+        std::istringstream again(line);
+        if (again >> word)
+          throw CliError{kExitBadInput, args.size_file + ": line " + std::to_string(ln) +
+                                            ": expected a number, found '" + word + "'"};
+        continue;  // empty or comment line
+      }
+      std::string rest;
+      if (ls >> rest)
+        throw CliError{kExitBadInput, args.size_file + ": line " + std::to_string(ln) +
+                                          ": expected one number per line"};
+      if (!(value > 0) || !std::isfinite(value))
+        throw CliError{kExitBadInput, args.size_file + ": line " + std::to_string(ln) +
+                                          ": sizes must be positive"};
+      input_size.push_back(value);
+    }
+    if (static_cast<int>(input_size.size()) != loaded.raw.n_vertices())
+      throw CliError{kExitBadInput, args.size_file + ": " + std::to_string(input_size.size()) +
+                                        " sizes for an input of " +
+                                        std::to_string(loaded.raw.n_vertices()) + " vertices"};
+    std::vector<double> vertex_size(mesh.n_vertices());
+    for (int v = 0; v < mesh.n_vertices(); ++v)
+      vertex_size[v] = input_size[loaded.repaired.vertex_origin[v]];
+    out.face_size = param::face_size_from_vertices(mesh, vertex_size);
+    out.report["mode"] = "file";
+    out.report["file"] = args.size_file;
+  } else {
+    out.report["mode"] = "uniform";
+    return out;
+  }
+  const auto [lo, hi] = std::minmax_element(out.face_size.begin(), out.face_size.end());
+  out.report["min"] = number(*lo);
+  out.report["max"] = number(*hi);
+  return out;
 }
 
 }  // namespace quadify::cli

@@ -110,6 +110,21 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
                                 const LoadedMesh& loaded, param::ParamOptions* options);
 nlohmann::json feature_json(const FeatureInput& input, const param::ParamStats& stats);
 
+// Sizing options shared by `param` and the remesher (paper section 7, isotropic scaling).
+struct SizingArgs {
+  bool adaptive = false;     // --adaptive: curvature-adaptive sizes (param::adaptive_face_size)
+  double max_ratio = 4;      // --adaptive-ratio
+  std::string size_file;     // --size-field FILE: one relative edge length per input vertex
+};
+void add_sizing_options(CLI::App& app, SizingArgs* args);
+// Per-face sizes of the repaired mesh (empty: uniform) and their report. Throws CliError naming
+// the file for an unreadable size field, a wrong count or a value that is not positive.
+struct SizingInput {
+  std::vector<double> face_size;
+  nlohmann::json report;
+};
+SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, Progress& progress);
+
 nlohmann::json to_json(const core::RepairReport& report);
 nlohmann::json to_json(const core::TopologyStats& stats);
 nlohmann::json input_json(const std::filesystem::path& path, const core::PolyMesh& raw);

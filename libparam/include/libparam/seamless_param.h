@@ -77,6 +77,12 @@ struct ParamOptions {
   // against 2.5: flipped quads fandisk 16 → 1, beetle 20 → 14, wingnut 1 → 0, for feature capture
   // fandisk 0.982 → 0.950 and beetle 0.980 → 0.932 (wingnut 0.807 → 0.846).
   double feature_max_wedge_stretch = 1.8;
+  // Isotropic sizing (paper section 7): the target edge length of each face relative to its 3D
+  // size (#F positive values; empty = uniform). The distortion energy compares the map with the
+  // triangle scaled by 1/face_size (the "transformed source triangle"), so a face of size 2 asks
+  // for quads twice as long as a face of size 1. libquantize must be given the same field
+  // (QuantizeOptions::face_size); only ratios matter there, as the map is scaled to the target.
+  std::vector<double> face_size;
   // Rotate the initial layout so that the largest group of feature directions lies along the u
   // axis (Alg. 4, k-means of the feature edge directions on the unit circle).
   bool feature_global_rotation = true;

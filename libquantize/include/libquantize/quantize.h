@@ -41,6 +41,11 @@ struct QuantizeOptions {
   double input_seam_tol = 1e-6;
   // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
   int threads = 0;
+  // Isotropic sizing: the same per-face sizes as param::ParamOptions::face_size (or empty). The
+  // re-optimizations use the sized rest shapes, and the target count and edge length refer to the
+  // sized area Σ area/size² (a size field normalized to keep that equal to the surface area, as
+  // the CLI's are, leaves the quad count where the target puts it).
+  std::vector<double> face_size;
   // Wall-clock limit of the quantization in seconds (0 = none). When it is exceeded the result
   // is kNotConverged with a message naming the scale, the stage and what to try.
   double time_budget_seconds = 0;

@@ -1,0 +1,133 @@
+// Sizing (paper section 7, isotropic): the curvature estimate, size fields from vertex values
+// and from curvature, and a seamless map that follows a size field.
+#include <libparam/seamless_param.h>
+#include <libparam/sizing.h>
+
+#include <libcore/predicates.h>
+#include <libcore/read_mesh.h>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "test_util.h"
+
+namespace quadify::param {
+namespace {
+
+core::TriMesh data_mesh(const std::string& name) {
+  return core::to_trimesh(core::read_mesh(test::data_path(name)));
+}
+
+// tests/data/sphere.obj (unit icosphere) stretched along x: an ellipsoid with semi-axes (a, 1, 1).
+core::TriMesh ellipsoid(double a) {
+  core::TriMesh m = data_mesh("sphere.obj");
+  m.V.col(0) *= a;
+  return m;
+}
+
+double face_area(const core::TriMesh& m, int f) {
+  const Eigen::Vector3d p0 = m.V.row(m.F(f, 0)), p1 = m.V.row(m.F(f, 1)), p2 = m.V.row(m.F(f, 2));
+  return 0.5 * (p1 - p0).cross(p2 - p0).norm();
+}
+
+TEST(Sizing, JetFittingFindsTheCurvaturesOfSpheresAndEllipsoids) {
+  core::TriMesh sphere = data_mesh("sphere.obj");
+  sphere.V *= 2.0;  // radius 2: both principal curvatures 1/2 (convex: positive w.r.t. the outward normal)
+  const VertexCurvature c = estimate_curvature(sphere);
+  for (int v = 0; v < sphere.n_vertices(); ++v) {
+    EXPECT_NEAR(c.k_max[v], 0.5, 0.02) << v;
+    EXPECT_NEAR(c.k_min[v], 0.5, 0.02) << v;
+  }
+  // Ellipsoid (3, 1, 1): at the tip (±3, 0, 0) both curvatures are a/b² = 3; on the equator
+  // x = 0 they are 1 (around x) and b/a² = 1/9 (along x), the larger across the long axis.
+  const core::TriMesh e = ellipsoid(3);
+  const VertexCurvature ce = estimate_curvature(e);
+  int tips = 0, equator = 0;
+  for (int v = 0; v < e.n_vertices(); ++v) {
+    if (std::abs(e.V(v, 0)) > 2.999) {
+      ++tips;
+      EXPECT_NEAR(ce.k_max[v], 3, 0.6) << "tip " << v;
+    } else if (std::abs(e.V(v, 0)) < 1e-9) {
+      ++equator;
+      EXPECT_NEAR(ce.k_max[v], 1, 0.1) << "equator " << v;
+      EXPECT_NEAR(ce.k_min[v], 1.0 / 9, 0.1) << "equator " << v;
+      const Eigen::Vector3d d_min = ce.d_min.row(v);
+      EXPECT_GT(std::abs(d_min.x()), 0.95) << "the weak direction runs along the long axis";
+    }
+  }
+  EXPECT_EQ(tips, 2);
+  EXPECT_GT(equator, 10);
+}
+
+TEST(Sizing, VertexValuesBecomeNormalizedFaceSizes) {
+  const core::TriMesh m = data_mesh("sphere.obj");
+  std::vector<double> vs(m.n_vertices());
+  for (int v = 0; v < m.n_vertices(); ++v) vs[v] = m.V(v, 0) > 0 ? 10.0 : 5.0;  // only ratios matter
+  const std::vector<double> fs = face_size_from_vertices(m, vs);
+  ASSERT_EQ(fs.size(), static_cast<size_t>(m.n_faces()));
+  double area = 0, sized = 0, lo = 1e9, hi = 0;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    area += face_area(m, f);
+    sized += face_area(m, f) / (fs[f] * fs[f]);
+    lo = std::min(lo, fs[f]);
+    hi = std::max(hi, fs[f]);
+  }
+  EXPECT_NEAR(sized, area, 1e-9 * area) << "the map keeps the surface's area";
+  EXPECT_NEAR(hi / lo, 2.0, 1e-9) << "faces wholly on either side keep the ratio of their values";
+  EXPECT_THROW((void)face_size_from_vertices(m, std::vector<double>(3, 1.0)), std::invalid_argument);
+  vs[7] = -1;
+  EXPECT_THROW((void)face_size_from_vertices(m, vs), std::invalid_argument);
+}
+
+TEST(Sizing, AdaptiveSizesAreSmallerWhereTheSurfaceBendsMore) {
+  const core::TriMesh e = ellipsoid(3);
+  AdaptiveSizingOptions o;
+  const std::vector<double> fs = adaptive_face_size(e, o);
+  double tip = 0, mid = 0;
+  int n_tip = 0, n_mid = 0;
+  for (int f = 0; f < e.n_faces(); ++f) {
+    const double x = (e.V(e.F(f, 0), 0) + e.V(e.F(f, 1), 0) + e.V(e.F(f, 2), 0)) / 3;
+    if (std::abs(x) > 2.5) tip += fs[f], ++n_tip;
+    if (std::abs(x) < 0.5) mid += fs[f], ++n_mid;
+  }
+  ASSERT_GT(n_tip, 0);
+  ASSERT_GT(n_mid, 0);
+  // Curvature 3 against 1: ideally 1/sqrt(3) = 0.58; the smoothing and the clamp soften it.
+  EXPECT_LT(tip / n_tip, 0.8 * mid / n_mid);
+  o.max_ratio = 1;
+  for (const double s : adaptive_face_size(e, o)) EXPECT_NEAR(s, 1.0, 1e-12) << "ratio 1: uniform";
+}
+
+// A seamless map with a size field: flip-free and seamless as always, and where faces ask for
+// twice the edge length their UV triangles are half as large (a quad there covers 4× the area).
+TEST(Sizing, SeamlessMapFollowsTheSizeField) {
+  const core::TriMesh m = data_mesh("sphere.obj");
+  ParamOptions o;
+  o.energy = Energy::kSymmetricDirichlet;
+  std::vector<double> vs(m.n_vertices());
+  for (int v = 0; v < m.n_vertices(); ++v) vs[v] = m.V(v, 2) > 0 ? 2.0 : 1.0;
+  o.face_size = face_size_from_vertices(m, vs);
+  const ParamResult r = compute_seamless_param(m, o);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_flipped, 0);
+  EXPECT_LT(r.stats.seam_residual, 1e-9);
+  double uv_top = 0, uv_bottom = 0, a_top = 0, a_bottom = 0;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    const Eigen::Vector2d a = r.uv.corner_uv.row(3 * f), b = r.uv.corner_uv.row(3 * f + 1),
+                          c = r.uv.corner_uv.row(3 * f + 2);
+    const double uv_area = 0.5 * std::abs((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+    const double z = (m.V(m.F(f, 0), 2) + m.V(m.F(f, 1), 2) + m.V(m.F(f, 2), 2)) / 3;
+    if (z > 0.3) uv_top += uv_area, a_top += face_area(m, f);
+    if (z < -0.3) uv_bottom += uv_area, a_bottom += face_area(m, f);
+  }
+  const double ratio = (uv_top / a_top) / (uv_bottom / a_bottom);
+  EXPECT_NEAR(ratio, 0.25, 0.08) << "UV area per surface area: 1/size²";
+  o.face_size.assign(3, 1.0);
+  EXPECT_EQ(compute_seamless_param(m, o).status.code(), core::StatusCode::kInvalidInput);
+}
+
+}  // namespace
+}  // namespace quadify::param
