@@ -200,6 +200,7 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   if (static_cast<int>(copies.corner_copy.size()) != 3 * nf ||
       (x0.size() != 2 * n && x0.size() != n_ext) || !(options.rest_scale > 0) ||
       (!options.face_size.empty() && static_cast<int>(options.face_size.size()) != nf) ||
+      (!options.face_metric.empty() && static_cast<int>(options.face_metric.size()) != nf) ||
       (!options.gauge_copies.empty() &&
        static_cast<int>(options.gauge_copies.size()) != copies.n_components)) {
     res.status = core::Status::invalid_input("solve_constrained_layout: sizes do not match");
@@ -235,17 +236,11 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k)
       domain.face_copies[f][k] = x_base / 2 + copies.corner_copy[3 * f + k];
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
-                          p2 = mesh.V.row(mesh.F(f, 2));
-    const double rs = options.face_size.empty() ? options.rest_scale : options.rest_scale / options.face_size[f];
-    const Eigen::Vector3d e1 = (p1 - p0) * rs, e2 = (p2 - p0) * rs;
-    const double l1 = e1.norm();
-    Eigen::Matrix2d dm;
-    dm << l1, e1.dot(e2) / l1, 0, e1.cross(e2).norm() / l1;
+    const Eigen::Matrix2d dm = sized_rest_frame(mesh, f, options.rest_scale, options.face_size,
+                                                options.face_metric, &domain.area[f]);
     domain.rest_inverse[f] = dm.inverse();
-    domain.area[f] = 0.5 * e1.cross(e2).norm();
     total_area += domain.area[f];
-    edge_len += l1;
+    edge_len += dm(0, 0);
   }
   edge_len /= std::max(nf, 1);
 
@@ -585,6 +580,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   if (static_cast<int>(copies.corner_copy.size()) != 3 * nf || x0.size() < 2 * n ||
       !(options.rest_scale > 0) ||
       (!options.face_size.empty() && static_cast<int>(options.face_size.size()) != nf) ||
+      (!options.face_metric.empty() && static_cast<int>(options.face_metric.size()) != nf) ||
       (!options.prefer_free.empty() && static_cast<int>(options.prefer_free.size()) != n) ||
       (!options.gauge_copies.empty() &&
        static_cast<int>(options.gauge_copies.size()) != copies.n_components))
@@ -613,15 +609,9 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   m.domain.area.resize(nf);
   for (int f = 0; f < nf; ++f) {
     for (int k = 0; k < 3; ++k) m.domain.face_copies[f][k] = copy_slot[copies.corner_copy[3 * f + k]];
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
-                          p2 = mesh.V.row(mesh.F(f, 2));
-    const double rs = options.face_size.empty() ? options.rest_scale : options.rest_scale / options.face_size[f];
-    const Eigen::Vector3d e1 = (p1 - p0) * rs, e2 = (p2 - p0) * rs;
-    const double l1 = e1.norm();
-    Eigen::Matrix2d dm;
-    dm << l1, e1.dot(e2) / l1, 0, e1.cross(e2).norm() / l1;
+    const Eigen::Matrix2d dm = sized_rest_frame(mesh, f, options.rest_scale, options.face_size,
+                                                options.face_metric, &m.domain.area[f]);
     m.domain.rest_inverse[f] = dm.inverse();
-    m.domain.area[f] = 0.5 * e1.cross(e2).norm();
   }
   const EnergyDensity ed = energy_density(options.energy);
   m.density = ed.density;

@@ -23,8 +23,30 @@ double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 
 }  // namespace
 
+Eigen::Matrix2d sized_rest_frame(const core::TriMesh& mesh, int f, double scale,
+                                 const std::vector<double>& face_size,
+                                 const std::vector<Eigen::Matrix3d>& face_metric, double* area) {
+  const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
+  Eigen::Vector3d e1 = Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0;
+  Eigen::Vector3d e2 = Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0;
+  if (!face_metric.empty()) {
+    e1 = face_metric[f] * e1;
+    e2 = face_metric[f] * e2;
+  }
+  const double s = face_size.empty() ? scale : scale / face_size[f];
+  e1 *= s;
+  e2 *= s;
+  const double l1 = e1.norm();
+  const double cr = e1.cross(e2).norm();
+  Eigen::Matrix2d dm;
+  dm << l1, e1.dot(e2) / l1, 0.0, cr / l1;
+  if (area) *area = 0.5 * cr;
+  return dm;
+}
+
 CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face,
-                            const std::vector<double>& face_size) {
+                            const std::vector<double>& face_size,
+                            const std::vector<Eigen::Matrix3d>& face_metric) {
   CutMesh cut;
   const int nf = mesh.n_faces();
   cut.topo = core::build_edge_topology(mesh);
@@ -88,22 +110,8 @@ CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face,
 
   cut.rest.resize(nf);
   cut.area.resize(nf);
-  for (int f = 0; f < nf; ++f) {
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0));
-    const Eigen::Vector3d e1 = Eigen::Vector3d(mesh.V.row(mesh.F(f, 1))) - p0;
-    const Eigen::Vector3d e2 = Eigen::Vector3d(mesh.V.row(mesh.F(f, 2))) - p0;
-    const double l1 = e1.norm();
-    const double cr = e1.cross(e2).norm();
-    Eigen::Matrix2d dm;
-    dm << l1, e1.dot(e2) / l1, 0.0, cr / l1;
-    cut.rest[f] = dm;
-    cut.area[f] = 0.5 * cr;
-    if (!face_size.empty()) {
-      cut.rest[f] /= face_size[f];
-      cut.area[f] /= face_size[f] * face_size[f];
-    }
-  }
-  cut.sized = !face_size.empty();
+  for (int f = 0; f < nf; ++f) cut.rest[f] = sized_rest_frame(mesh, f, 1.0, face_size, face_metric, &cut.area[f]);
+  cut.sized = !face_size.empty() || !face_metric.empty();
   return cut;
 }
 

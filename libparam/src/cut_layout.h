@@ -39,12 +39,21 @@ struct CutMesh {
   bool sized = false;                     // rest shapes of different scales (a size field)
 };
 
+// The rest frame of face f (columns p1−p0, p2−p0 in a 2D frame of the triangle, p1 on the
+// positive x axis) and its area, for the triangle scaled by `scale`, mapped by the face's target
+// metric (face_metric[f], 3×3 on the 3D edge vectors, if given) and scaled by 1/face_size[f] (if
+// given): the target shape of the face in the map (paper section 7).
+Eigen::Matrix2d sized_rest_frame(const core::TriMesh& mesh, int f, double scale,
+                                 const std::vector<double>& face_size,
+                                 const std::vector<Eigen::Matrix3d>& face_metric, double* area);
+
 // Cuts a connected, manifold, consistently oriented mesh along a BFS dual spanning tree rooted at
 // face `seed_face`. Vertex copies are the corners merged across the tree edges (in BFS order, so
 // copy ids grow away from the root). face_size (#F positive values, or empty): the target edge
 // length of each face relative to its 3D size; rest frames are the triangles scaled by 1/size.
 CutMesh cut_along_dual_tree(const core::TriMesh& mesh, int seed_face = 0,
-                            const std::vector<double>& face_size = {});
+                            const std::vector<double>& face_size = {},
+                            const std::vector<Eigen::Matrix3d>& face_metric = {});
 
 // Isometric layout of the cut mesh, face by face in BFS order: (#copies)×2 positions. With a size
 // field (cut.sized) each face is placed by the similarity that maps its rest edge onto the edge

@@ -85,10 +85,11 @@ double batch_threshold(const ParamOptions& o, int i) {
 // feature_edges: component-local vertex pairs of feature edges (edges of `mesh`).
 ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options,
                               const std::vector<std::array<int, 2>>& feature_edges,
-                              const std::vector<double>& face_size) {
+                              const std::vector<double>& face_size,
+                              const std::vector<Eigen::Matrix3d>& face_metric) {
   ComponentOutput out;
   const auto t0 = Clock::now();
-  const CutMesh cut = cut_along_dual_tree(mesh, 0, face_size);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0, face_size, face_metric);
   const LayoutDomain domain = make_domain(cut);
   // x: the copies' UVs and the seam translations (seam_basis.h); the energy reads the copies.
   const int n_copy_vars = 2 * cut.n_copies();
@@ -518,6 +519,19 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
       if (!(s > 0) || !std::isfinite(s))
         return core::Status::invalid_input("face_size values must be finite and positive");
   }
+  if (!o.face_metric.empty()) {
+    if (static_cast<int>(o.face_metric.size()) != mesh.n_faces())
+      return core::Status::invalid_input("face_metric has " + std::to_string(o.face_metric.size()) +
+                                         " matrices for " + std::to_string(mesh.n_faces()) + " faces");
+    for (int f = 0; f < mesh.n_faces(); ++f) {
+      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                            p2 = mesh.V.row(mesh.F(f, 2));
+      const Eigen::Vector3d n = (o.face_metric[f] * (p1 - p0)).cross(o.face_metric[f] * (p2 - p0));
+      if (!o.face_metric[f].allFinite() || !(n.norm() > 0))
+        return core::Status::invalid_input("face_metric of face " + std::to_string(f) +
+                                           " is not finite or flattens the face");
+    }
+  }
   if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
   for (int f = 0; f < mesh.n_faces(); ++f) {
     for (int k = 0; k < 3; ++k)
@@ -590,9 +604,12 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     }
   }
   std::vector<std::vector<double>> sub_size(n_comp);
-  if (!options.face_size.empty())
-    for (int c = 0; c < n_comp; ++c)
-      for (const int f : sub_faces[c]) sub_size[c].push_back(options.face_size[f]);
+  std::vector<std::vector<Eigen::Matrix3d>> sub_metric(n_comp);
+  for (int c = 0; c < n_comp; ++c)
+    for (const int f : sub_faces[c]) {
+      if (!options.face_size.empty()) sub_size[c].push_back(options.face_size[f]);
+      if (!options.face_metric.empty()) sub_metric[c].push_back(options.face_metric[f]);
+    }
   std::vector<ComponentOutput> outs(n_comp);
   // Components may run on worker threads: serialize the progress callback.
   ParamOptions component_options = options;
@@ -609,12 +626,12 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   plain_options.align_boundaries = false;
   std::vector<char> fell_back(n_comp, 0);
   auto work = [&](int c) {
-    outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c]);
+    outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c], sub_metric[c]);
     if (outs[c].status.is_ok() || outs[c].status.code() == core::StatusCode::kInvalidInput ||
         outs[c].stats.n_feature_edges == 0)
       return;
     const int n_features = outs[c].stats.n_feature_edges;
-    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c]);
+    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c]);
     outs[c].stats.n_feature_edges = n_features;
     outs[c].stats.n_disabled_features = n_features;
     fell_back[c] = 1;

@@ -1,8 +1,11 @@
 #include <libparam/sizing.h>
 
+#include "cut_layout.h"
+
 #define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Monge_via_jet_fitting.h>
 #include <CGAL/Simple_cartesian.h>
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -109,6 +112,17 @@ VertexCurvature estimate_curvature(const core::TriMesh& mesh, int rings) {
   return out;
 }
 
+double sized_area(const core::TriMesh& mesh, const std::vector<double>& face_size,
+                  const std::vector<Eigen::Matrix3d>& face_metric) {
+  double total = 0;
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    double a = 0;
+    (void)sized_rest_frame(mesh, f, 1.0, face_size, face_metric, &a);
+    total += a;
+  }
+  return total;
+}
+
 std::vector<double> face_size_from_vertices(const core::TriMesh& mesh,
                                             const std::vector<double>& vertex_size) {
   if (static_cast<int>(vertex_size.size()) != mesh.n_vertices())
@@ -138,60 +152,144 @@ std::vector<double> face_size_from_vertices(const core::TriMesh& mesh,
   return size;
 }
 
-std::vector<double> adaptive_face_size(const core::TriMesh& mesh, const AdaptiveSizingOptions& options) {
-  const int nv = mesh.n_vertices();
-  if (!(options.max_ratio >= 1)) throw std::invalid_argument("max_ratio must be >= 1");
-  const VertexCurvature curvature = estimate_curvature(mesh);
-  // Vertex areas (a third of each face) for the area-weighted median curvature.
-  std::vector<double> vertex_area(nv, 0);
+namespace {
+
+std::vector<double> vertex_areas(const core::TriMesh& mesh) {
+  std::vector<double> vertex_area(mesh.n_vertices(), 0);
   for (int f = 0; f < mesh.n_faces(); ++f) {
     const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
                           p2 = mesh.V.row(mesh.F(f, 2));
     const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm() / 3;
     for (int k = 0; k < 3; ++k) vertex_area[mesh.F(f, k)] += a;
   }
-  std::vector<double> kappa(nv);
+  return vertex_area;
+}
+
+// The area-weighted median of per-vertex values.
+double weighted_median(const std::vector<double>& value, const std::vector<double>& weight) {
   std::vector<int> order;
   double total = 0;
-  for (int v = 0; v < nv; ++v) {
-    kappa[v] = std::max(std::abs(curvature.k_max[v]), std::abs(curvature.k_min[v]));
-    if (vertex_area[v] > 0) {
-      order.push_back(v);
-      total += vertex_area[v];
+  for (size_t v = 0; v < value.size(); ++v)
+    if (weight[v] > 0) {
+      order.push_back(static_cast<int>(v));
+      total += weight[v];
     }
-  }
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return kappa[a] < kappa[b] || (kappa[a] == kappa[b] && a < b); });
-  double kappa_ref = 0, acc = 0;
+  std::sort(order.begin(), order.end(),
+            [&](int a, int b) { return value[a] < value[b] || (value[a] == value[b] && a < b); });
+  double acc = 0;
   for (const int v : order) {
-    acc += vertex_area[v];
-    if (acc >= 0.5 * total) {
-      kappa_ref = kappa[v];
-      break;
-    }
+    acc += weight[v];
+    if (acc >= 0.5 * total) return value[v];
   }
-  std::vector<double> log_size(nv, 0);
-  const double half_range = 0.5 * std::log(options.max_ratio);
-  if (kappa_ref > 0)
-    for (int v = 0; v < nv; ++v)
-      log_size[v] = std::clamp(0.5 * (std::log(kappa_ref) - std::log(std::max(kappa[v], 1e-300))),
-                               -half_range, half_range);
-  const std::vector<std::vector<int>> nb = vertex_neighbours(mesh);
-  std::vector<double> next(nv);
-  for (int pass = 0; pass < options.smoothing_passes; ++pass) {
-    for (int v = 0; v < nv; ++v) {
+  return 0;
+}
+
+// log(edge length) for a curvature magnitude, relative to the reference curvature, clamped.
+double log_length(double kappa, double kappa_ref, double half_range) {
+  if (!(kappa_ref > 0)) return 0;
+  return std::clamp(0.5 * (std::log(kappa_ref) - std::log(std::max(kappa, 1e-300))), -half_range,
+                    half_range);
+}
+
+// Passes of averaging each vertex's values with its neighbours' mean (weights ½, ½).
+template <class T>
+void smooth(const std::vector<std::vector<int>>& nb, int passes, std::vector<T>* values) {
+  std::vector<T> next(values->size());
+  for (int pass = 0; pass < passes; ++pass) {
+    for (size_t v = 0; v < values->size(); ++v) {
       if (nb[v].empty()) {
-        next[v] = log_size[v];
+        next[v] = (*values)[v];
         continue;
       }
-      double s = 0;
-      for (const int u : nb[v]) s += log_size[u];
-      next[v] = 0.5 * log_size[v] + 0.5 * s / static_cast<double>(nb[v].size());
+      T sum = (*values)[nb[v][0]];
+      for (size_t i = 1; i < nb[v].size(); ++i) sum = sum + (*values)[nb[v][i]];
+      next[v] = 0.5 * (*values)[v] + (0.5 / static_cast<double>(nb[v].size())) * sum;
     }
-    log_size.swap(next);
+    values->swap(next);
   }
+}
+
+}  // namespace
+
+std::vector<double> adaptive_face_size(const core::TriMesh& mesh, const AdaptiveSizingOptions& options) {
+  const int nv = mesh.n_vertices();
+  if (!(options.max_ratio >= 1)) throw std::invalid_argument("max_ratio must be >= 1");
+  const VertexCurvature curvature = estimate_curvature(mesh);
+  std::vector<double> kappa(nv);
+  for (int v = 0; v < nv; ++v)
+    kappa[v] = std::max(std::abs(curvature.k_max[v]), std::abs(curvature.k_min[v]));
+  const double kappa_ref = weighted_median(kappa, vertex_areas(mesh));
+  const double half_range = 0.5 * std::log(options.max_ratio);
+  std::vector<double> log_size(nv);
+  for (int v = 0; v < nv; ++v) log_size[v] = log_length(kappa[v], kappa_ref, half_range);
+  smooth(vertex_neighbours(mesh), options.smoothing_passes, &log_size);
   std::vector<double> vertex_size(nv);
   for (int v = 0; v < nv; ++v) vertex_size[v] = std::exp(log_size[v]);
   return face_size_from_vertices(mesh, vertex_size);
+}
+
+std::vector<Eigen::Matrix3d> adaptive_face_metric(const core::TriMesh& mesh,
+                                                  const AdaptiveSizingOptions& options) {
+  const int nv = mesh.n_vertices(), nf = mesh.n_faces();
+  if (!(options.max_ratio >= 1)) throw std::invalid_argument("max_ratio must be >= 1");
+  const VertexCurvature c = estimate_curvature(mesh);
+  std::vector<double> kappa(nv);
+  for (int v = 0; v < nv; ++v) kappa[v] = std::max(std::abs(c.k_max[v]), std::abs(c.k_min[v]));
+  // The reference is the median of the larger curvature, as for isotropic sizing; the direction
+  // of lesser curvature may get up to √max_ratio longer edges than that.
+  const double kappa_ref = weighted_median(kappa, vertex_areas(mesh));
+  const double half_range = 0.5 * std::log(options.max_ratio);
+  const std::vector<std::vector<int>> nb = vertex_neighbours(mesh);
+  // Per vertex: log lengths along the two principal directions, and the directions' outer
+  // products (sign-free, so they average across neighbours).
+  std::vector<Eigen::Vector2d> log_len(nv, Eigen::Vector2d::Zero());
+  std::vector<Eigen::Matrix3d> frame(nv, Eigen::Matrix3d::Zero());
+  for (int v = 0; v < nv; ++v) {
+    const Eigen::Vector3d d1 = c.d_max.row(v), d2 = c.d_min.row(v);
+    if (d1.squaredNorm() == 0) continue;  // no estimate: isotropic, length 1
+    log_len[v] = {log_length(std::abs(c.k_max[v]), kappa_ref, half_range),
+                  log_length(std::abs(c.k_min[v]), kappa_ref, half_range)};
+    // frame = P1 − P2: +1 along d_max, −1 along d_min; a projector pair recovered after averaging.
+    frame[v] = d1 * d1.transpose() - d2 * d2.transpose();
+  }
+  smooth(nb, options.smoothing_passes, &log_len);
+  smooth(nb, options.smoothing_passes, &frame);
+  std::vector<Eigen::Matrix3d> metric(nf);
+  std::vector<double> no_size;
+  for (int f = 0; f < nf; ++f) {
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                          p2 = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0).normalized();
+    Eigen::Matrix3d fr = Eigen::Matrix3d::Zero();
+    Eigen::Vector2d ll = Eigen::Vector2d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      fr += frame[mesh.F(f, k)] / 3.0;
+      ll += log_len[mesh.F(f, k)] / 3.0;
+    }
+    // The direction of larger curvature: the top eigenvector of the averaged frame, projected
+    // into the face's plane; the other is n × d1.
+    const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(tangent * fr * tangent);
+    Eigen::Vector3d d1 = tangent * es.eigenvectors().col(2);
+    // Anisotropy fades where the averaged directions disagree (small eigenvalue spread).
+    const double coherence = std::clamp(es.eigenvalues()(2) - es.eigenvalues()(0), 0.0, 2.0) / 2;
+    if (d1.norm() < 1e-9) d1 = (p1 - p0);
+    d1.normalize();
+    const Eigen::Vector3d d2 = n.cross(d1);
+    const double mean = 0.5 * (ll(0) + ll(1));
+    const double l1 = std::exp(mean + coherence * (ll(0) - mean));
+    const double l2 = std::exp(mean + coherence * (ll(1) - mean));
+    metric[f] = d1 * d1.transpose() / l1 + d2 * d2.transpose() / l2 +
+                n * n.transpose() / std::sqrt(l1 * l2);
+  }
+  // Normalize: the sized area equals the surface area.
+  const double area = sized_area(mesh, {}, {});
+  const double sized = sized_area(mesh, no_size, metric);
+  if (area > 0 && sized > 0) {
+    const double lambda = std::sqrt(area / sized);
+    for (auto& m : metric) m *= lambda;
+  }
+  return metric;
 }
 
 }  // namespace quadify::param

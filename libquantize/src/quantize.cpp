@@ -37,6 +37,8 @@
 #include <libparam/constrained_layout.h>
 #include <libquantize/quantize.h>
 
+#include <libparam/sizing.h>
+
 #include <Eigen/Geometry>
 
 #ifdef QUADIFY_WITH_TBB
@@ -688,18 +690,13 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
 
   // Scale.
   double area3d = surface_area(mesh);
-  if (!options.face_size.empty()) {
-    if (static_cast<int>(options.face_size.size()) != nf) {
-      out.status = core::Status::invalid_input("face_size has " + std::to_string(options.face_size.size()) +
-                                               " values for " + std::to_string(nf) + " faces");
+  if (!options.face_size.empty() || !options.face_metric.empty()) {
+    if ((!options.face_size.empty() && static_cast<int>(options.face_size.size()) != nf) ||
+        (!options.face_metric.empty() && static_cast<int>(options.face_metric.size()) != nf)) {
+      out.status = core::Status::invalid_input("face_size or face_metric does not have one entry per face");
       return out;
     }
-    area3d = 0;
-    for (int f = 0; f < nf; ++f) {
-      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
-                            p2 = mesh.V.row(mesh.F(f, 2));
-      area3d += 0.5 * (p1 - p0).cross(p2 - p0).norm() / (options.face_size[f] * options.face_size[f]);
-    }
+    area3d = param::sized_area(mesh, options.face_size, options.face_metric);
   }
   const double area_uv = uv_area(cl, cl.x, nf);
   double scale = 0;
@@ -719,6 +716,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   param::PinnedLayoutOptions lopt;
   lopt.energy = options.energy;
   lopt.face_size = options.face_size;
+  lopt.face_metric = options.face_metric;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
   std::vector<char> feature_coords;

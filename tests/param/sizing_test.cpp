@@ -101,6 +101,37 @@ TEST(Sizing, AdaptiveSizesAreSmallerWhereTheSurfaceBendsMore) {
   for (const double s : adaptive_face_size(e, o)) EXPECT_NEAR(s, 1.0, 1e-12) << "ratio 1: uniform";
 }
 
+TEST(Sizing, AnisotropicMetricIsLongerAlongTheDirectionOfLesserCurvature) {
+  const core::TriMesh e = ellipsoid(3);
+  const std::vector<Eigen::Matrix3d> metric = adaptive_face_metric(e);
+  ASSERT_EQ(metric.size(), static_cast<size_t>(e.n_faces()));
+  double area = 0;
+  for (int f = 0; f < e.n_faces(); ++f) area += face_area(e, f);
+  EXPECT_NEAR(sized_area(e, {}, metric), area, 1e-9 * area) << "normalized: the map keeps the area";
+  // Around the middle (curvature 1 around, 1/9 along x) the metric shrinks x less: edges along x
+  // ask to be longer (|M·x̂| small) than edges around (|M·ŷ| or |M·ẑ|, whichever is tangent).
+  int n = 0;
+  for (int f = 0; f < e.n_faces(); ++f) {
+    const Eigen::Vector3d p0 = e.V.row(e.F(f, 0)), p1 = e.V.row(e.F(f, 1)), p2 = e.V.row(e.F(f, 2));
+    const Eigen::Vector3d c = (p0 + p1 + p2) / 3;
+    if (std::abs(c.x()) > 0.3) continue;
+    const Eigen::Vector3d around = Eigen::Vector3d(0, -c.z(), c.y()).normalized();
+    EXPECT_GT((metric[f] * around).norm(), 1.5 * (metric[f] * Eigen::Vector3d::UnitX()).norm()) << f;
+    ++n;
+  }
+  EXPECT_GT(n, 10);
+  // The parametrization takes it like a size field: flip-free and seamless.
+  ParamOptions o;
+  o.energy = Energy::kSymmetricDirichlet;
+  o.face_metric = metric;
+  const ParamResult r = compute_seamless_param(e, o);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_flipped, 0);
+  o.face_metric.assign(e.n_faces(), Eigen::Matrix3d::Zero());
+  EXPECT_EQ(compute_seamless_param(e, o).status.code(), core::StatusCode::kInvalidInput)
+      << "a metric that flattens the faces is bad input";
+}
+
 // A seamless map with a size field: flip-free and seamless as always, and where faces ask for
 // twice the edge length their UV triangles are half as large (a quad there covers 4× the area).
 TEST(Sizing, SeamlessMapFollowsTheSizeField) {

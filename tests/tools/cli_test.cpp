@@ -302,8 +302,9 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
 }
 
 // --adaptive: on an ellipsoid (3, 1, 1) the quads at the tips (curvature 3) come out smaller
-// than around the middle (curvature 1), more so than the map's own distortion makes them.
-TEST_F(CliTest, AdaptiveSizingMakesSmallerQuadsWhereTheSurfaceBendsMore) {
+// than around the middle (curvature 1), more so than the map's own distortion makes them;
+// --anisotropic: quads around the middle stretch along the axis.
+TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   std::ostringstream obj;
   {
     std::istringstream in(slurp(data_path("sphere.obj")));
@@ -320,7 +321,12 @@ TEST_F(CliTest, AdaptiveSizingMakesSmallerQuadsWhereTheSurfaceBendsMore) {
   }
   const fs::path in = dir_ / "ellipsoid.obj";
   write_text(in, obj.str());
-  auto tip_over_middle = [&](const std::string& extra) {
+  // Mean quad edge at the tips (|x| > 2.5) over the middle (|x| < 0.5), and in the middle, mean
+  // edge along the long axis over around it.
+  struct Shape {
+    double tip_over_middle, along_over_around;
+  };
+  auto remesh = [&](const std::string& extra) {
     const fs::path out = dir_ / "q.obj";
     std::string args;
     args.append("'").append(in.string()).append("' -o '").append(out.string());
@@ -331,9 +337,10 @@ TEST_F(CliTest, AdaptiveSizingMakesSmallerQuadsWhereTheSurfaceBendsMore) {
     const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
     EXPECT_EQ(report["quads"]["non_quads"], 0);
     EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+    EXPECT_NEAR(report["quads"]["faces"].get<int>(), 600, 60) << "the count stays near the target";
     std::vector<Eigen::Vector3d> v;
-    double tip = 0, middle = 0;
-    int n_tip = 0, n_middle = 0;
+    double tip = 0, middle = 0, along = 0, around = 0;
+    int n_tip = 0, n_middle = 0, n_along = 0, n_around = 0;
     std::istringstream qs(slurp(out));
     for (std::string line; std::getline(qs, line);) {
       std::istringstream ls(line.substr(std::min<size_t>(2, line.size())));
@@ -347,23 +354,39 @@ TEST_F(CliTest, AdaptiveSizingMakesSmallerQuadsWhereTheSurfaceBendsMore) {
         Eigen::Vector3d c = Eigen::Vector3d::Zero();
         double len = 0;
         for (size_t i = 0; i < ids.size(); ++i) {
+          const Eigen::Vector3d e = v[ids[(i + 1) % ids.size()]] - v[ids[i]];
           c += v[ids[i]] / static_cast<double>(ids.size());
-          len += (v[ids[i]] - v[ids[(i + 1) % ids.size()]]).norm() / static_cast<double>(ids.size());
+          len += e.norm() / static_cast<double>(ids.size());
         }
         if (std::abs(c.x()) > 2.5) tip += len, ++n_tip;
-        if (std::abs(c.x()) < 0.5) middle += len, ++n_middle;
+        if (std::abs(c.x()) < 0.5) {
+          middle += len, ++n_middle;
+          for (size_t i = 0; i < ids.size(); ++i) {
+            const Eigen::Vector3d e = v[ids[(i + 1) % ids.size()]] - v[ids[i]];
+            if (std::abs(e.x()) > 0.8 * e.norm()) along += e.norm(), ++n_along;
+            if (std::abs(e.x()) < 0.3 * e.norm()) around += e.norm(), ++n_around;
+          }
+        }
       }
     }
     EXPECT_GT(n_tip, 0);
     EXPECT_GT(n_middle, 0);
-    return (tip / std::max(n_tip, 1)) / (middle / std::max(n_middle, 1));
+    EXPECT_GT(n_along, 0);
+    EXPECT_GT(n_around, 0);
+    return Shape{(tip / std::max(n_tip, 1)) / (middle / std::max(n_middle, 1)),
+                 (along / std::max(n_along, 1)) / (around / std::max(n_around, 1))};
   };
-  const double uniform = tip_over_middle("");
-  const double adaptive = tip_over_middle("--adaptive");
-  EXPECT_LT(adaptive, uniform - 0.08) << "uniform " << uniform << ", adaptive " << adaptive;
-  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
-  EXPECT_EQ(report["param"]["sizing"]["mode"], "adaptive");
-  EXPECT_NEAR(report["quads"]["faces"].get<int>(), 600, 60) << "the count stays near the target";
+  const Shape uniform = remesh("");
+  const Shape adaptive = remesh("--adaptive");
+  EXPECT_LT(adaptive.tip_over_middle, uniform.tip_over_middle - 0.08)
+      << "uniform " << uniform.tip_over_middle << ", adaptive " << adaptive.tip_over_middle;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["param"]["sizing"]["mode"], "adaptive");
+  EXPECT_NEAR(adaptive.along_over_around, 1, 0.2) << "isotropic: square quads";
+  // Anisotropic: around the middle the surface bends 9× less along x (curvature 1/9 against 1),
+  // so quads stretch along x (up to the ratio 4 of the lengths: 2× along, ½× around).
+  const Shape anisotropic = remesh("--adaptive --anisotropic");
+  EXPECT_GT(anisotropic.along_over_around, 1.4) << "along/around " << anisotropic.along_over_around;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["param"]["sizing"]["mode"], "adaptive-anisotropic");
 }
 
 // A size field file: one positive number per input vertex; a bad line or count is bad input.

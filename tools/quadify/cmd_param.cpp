@@ -37,6 +37,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
   const FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &options);
   SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   options.face_size = std::move(sizing.face_size);
+  options.face_metric = std::move(sizing.face_metric);
   options.progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
   };

@@ -62,6 +62,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   param_options.face_size = sizing.face_size;
   quantize_options.face_size = sizing.face_size;
+  param_options.face_metric = sizing.face_metric;
+  quantize_options.face_metric = sizing.face_metric;
   // Boundaries as explicit feature edges, so that curves too small for the density (tiny holes,
   // short creases) can be left unaligned.
   if (param_options.align_boundaries) {

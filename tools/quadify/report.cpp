@@ -5,6 +5,8 @@
 #include <libcore/status.h>
 #include <libparam/sizing.h>
 
+#include <Eigen/SVD>
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -294,6 +296,11 @@ void add_sizing_options(CLI::App& app, SizingArgs* a) {
                  "With --adaptive: largest over smallest quad edge length")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
+  app.add_flag("--anisotropic", a->anisotropic,
+               "With --adaptive: a length per principal direction (∝ 1/sqrt of that curvature), so "
+               "quads stretch along the direction in which the surface bends less (cylinders, "
+               "fillets), within --adaptive-ratio")
+      ->needs(adaptive);
   app.add_option("--size-field", a->size_file,
                  "Relative quad edge length per input vertex: a text file of one positive number per "
                  "line, in the input's vertex order ('#' starts a comment); only ratios matter")
@@ -308,6 +315,25 @@ SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, 
     progress.begin("sizing");
     param::AdaptiveSizingOptions o;
     o.max_ratio = args.max_ratio;
+    if (args.anisotropic) {
+      out.face_metric = param::adaptive_face_metric(mesh, o);
+      progress.end();
+      // Edge lengths asked for: the reciprocals of the metric's two larger singular values
+      // (the third acts along the normal).
+      double lo = INFINITY, hi = 0;
+      for (const Eigen::Matrix3d& m : out.face_metric) {
+        const Eigen::Vector3d sv = Eigen::JacobiSVD<Eigen::Matrix3d>(m).singularValues();
+        lo = std::min(lo, 1 / sv(0));
+        hi = std::max(hi, 1 / sv(0));
+        lo = std::min(lo, 1 / sv(1));
+        hi = std::max(hi, 1 / sv(1));
+      }
+      out.report["mode"] = "adaptive-anisotropic";
+      out.report["max_ratio"] = args.max_ratio;
+      out.report["min"] = number(lo);
+      out.report["max"] = number(hi);
+      return out;
+    }
     out.face_size = param::adaptive_face_size(mesh, o);
     progress.end();
     out.report["mode"] = "adaptive";

@@ -114,6 +114,7 @@ nlohmann::json feature_json(const FeatureInput& input, const param::ParamStats& 
 struct SizingArgs {
   bool adaptive = false;     // --adaptive: curvature-adaptive sizes (param::adaptive_face_size)
   double max_ratio = 4;      // --adaptive-ratio
+  bool anisotropic = false;  // --anisotropic: per-direction lengths (param::adaptive_face_metric)
   std::string size_file;     // --size-field FILE: one relative edge length per input vertex
 };
 void add_sizing_options(CLI::App& app, SizingArgs* args);
@@ -121,6 +122,7 @@ void add_sizing_options(CLI::App& app, SizingArgs* args);
 // the file for an unreadable size field, a wrong count or a value that is not positive.
 struct SizingInput {
   std::vector<double> face_size;
+  std::vector<Eigen::Matrix3d> face_metric;
   nlohmann::json report;
 };
 SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, Progress& progress);

@@ -66,6 +66,9 @@ struct ConstrainedLayoutOptions {
   // Isotropic sizing (param::ParamOptions::face_size): rest shapes of face f are further scaled
   // by 1/face_size[f] (#F positive values, or empty).
   std::vector<double> face_size;
+  // Anisotropic sizing (param::ParamOptions::face_metric): face f's 3D edge vectors are mapped by
+  // face_metric[f] before its rest shape is taken (#F, or empty).
+  std::vector<Eigen::Matrix3d> face_metric;
   int max_newton_iters = 60;
   // Newton stop: decrement below this fraction of the energy.
   double relative_tolerance = 1e-6;
@@ -130,8 +133,9 @@ struct PinnedLayoutOptions {
   Energy energy = Energy::kSymmetricDirichlet;  // kTau is optimized as symmetric Dirichlet
   // Rest shapes are the 3D triangles scaled by this factor (UV units per model unit).
   double rest_scale = 1;
-  // Isotropic sizing, as ConstrainedLayoutOptions::face_size.
+  // Sizing, as ConstrainedLayoutOptions::face_size and face_metric.
   std::vector<double> face_size;
+  std::vector<Eigen::Matrix3d> face_metric;
   // One copy per component keeps its position (the translation gauge); -1 = the first copy.
   std::vector<int> gauge_copies;
   // Per copy (#copies, or empty): keep its coordinates as free variables where possible.

@@ -7,6 +7,8 @@
 #include <libcore/mesh.h>
 #include <libcore/status.h>
 
+#include <Eigen/Core>
+
 #include <array>
 #include <functional>
 #include <string>
@@ -83,6 +85,11 @@ struct ParamOptions {
   // for quads twice as long as a face of size 1. libquantize must be given the same field
   // (QuantizeOptions::face_size); only ratios matter there, as the map is scaled to the target.
   std::vector<double> face_size;
+  // Anisotropic sizing (paper section 7): per face a 3×3 matrix applied to its 3D edge vectors
+  // before its rest shape is taken (#F, or empty), e.g. diag(1/s1, 1/s2, ·) in a principal
+  // frame asks for quads of edge lengths s1 and s2 along the two directions; combined with
+  // face_size when both are given. libquantize needs the same (QuantizeOptions::face_metric).
+  std::vector<Eigen::Matrix3d> face_metric;
   // Rotate the initial layout so that the largest group of feature directions lies along the u
   // axis (Alg. 4, k-means of the feature edge directions on the unit circle).
   bool feature_global_rotation = true;

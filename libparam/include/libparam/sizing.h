@@ -43,11 +43,25 @@ struct AdaptiveSizingOptions {
 [[nodiscard]] std::vector<double> adaptive_face_size(const core::TriMesh& mesh,
                                                      const AdaptiveSizingOptions& options = {});
 
+// Curvature-adaptive anisotropic sizing: per face a metric (param::ParamOptions::face_metric)
+// asking for edge length ∝ 1/sqrt(|κ|) along each principal direction (longer quads along the
+// direction in which the surface bends less, e.g. along a cylinder's axis), each length clamped
+// to max_ratio around the median-curvature length, smoothed like adaptive_face_size (log
+// lengths, and the directions through their outer products), and normalized so that the sized
+// area equals the surface area.
+[[nodiscard]] std::vector<Eigen::Matrix3d> adaptive_face_metric(
+    const core::TriMesh& mesh, const AdaptiveSizingOptions& options = {});
+
 // Per-vertex relative edge lengths (#V positive values) → per-face sizes: the geometric mean of
 // the face's corners, normalized so that Σ area/size² = Σ area (the map's area, and so the quad
 // count of a target, is unchanged). Throws std::invalid_argument on a wrong count or a value that
 // is not finite and positive.
 [[nodiscard]] std::vector<double> face_size_from_vertices(const core::TriMesh& mesh,
                                                           const std::vector<double>& vertex_size);
+
+// The area of the mesh's target shapes: Σ over faces of the area of the triangle mapped by
+// face_metric[f] and scaled by 1/face_size[f] (either may be empty); the surface area if both are.
+[[nodiscard]] double sized_area(const core::TriMesh& mesh, const std::vector<double>& face_size,
+                                const std::vector<Eigen::Matrix3d>& face_metric);
 
 }  // namespace quadify::param

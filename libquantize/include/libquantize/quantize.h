@@ -46,6 +46,7 @@ struct QuantizeOptions {
   // sized area Σ area/size² (a size field normalized to keep that equal to the surface area, as
   // the CLI's are, leaves the quad count where the target puts it).
   std::vector<double> face_size;
+  std::vector<Eigen::Matrix3d> face_metric;  // as param::ParamOptions::face_metric (or empty)
   // Wall-clock limit of the quantization in seconds (0 = none). When it is exceeded the result
   // is kNotConverged with a message naming the scale, the stage and what to try.
   double time_budget_seconds = 0;
