@@ -1,5 +1,7 @@
 #include <libquadex/quad_metrics.h>
 
+#include <libcore/curvature.h>
+
 #include <libcore/predicates.h>
 #include <libcore/topology.h>
 
@@ -349,8 +351,12 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
     const TriangleSurface quad_surface(core::to_trimesh(quads));
     if (!ref.empty() && !quad_surface.empty() && diag > 0) {
       m.has_reference = true;
-      // Orientation against the reference: the reference face closest to the quad centroid.
+      // Orientation against the reference: the reference face closest to the quad centroid; and
+      // there, the principal directions for the alignment measure.
+      core::VertexCurvature curvature;
+      if (options.curvature_alignment) curvature = core::estimate_curvature(*reference);
       std::vector<char> facing_away(quad_faces.size(), 0);
+      std::vector<double> angle_sum(quad_faces.size(), -1);
       parallel_for_each_index(quad_faces.size(), [&](size_t i) {
         const int f = quad_faces[i];
         Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
@@ -360,8 +366,38 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
         const Eigen::Vector3d a = to_eigen(t[0]);
         const Eigen::Vector3d ref_normal = (to_eigen(t[1]) - a).cross(to_eigen(t[2]) - a);
         facing_away[i] = quad_normal[i].dot(ref_normal) < 0;
+        if (!options.curvature_alignment || !(ref_normal.norm() > 0)) return;
+        const int rf = ref.face[static_cast<size_t>(hit.second - ref.triangles.begin())];
+        int best = reference->F(rf, 0);
+        for (int k = 1; k < 3; ++k)
+          if ((reference->V.row(reference->F(rf, k)).transpose() - centroid).squaredNorm() <
+              (reference->V.row(best).transpose() - centroid).squaredNorm())
+            best = reference->F(rf, k);
+        const double k1 = std::abs(curvature.k_max[best]), k2 = std::abs(curvature.k_min[best]);
+        const double big = std::max(k1, k2), small = std::min(k1, k2);
+        if (!(big >= 2 * small) || !(big * diag >= 4)) return;
+        const Eigen::Vector3d n = ref_normal.normalized();
+        Eigen::Vector3d d = k1 >= k2 ? curvature.d_max.row(best).transpose() : curvature.d_min.row(best).transpose();
+        d -= d.dot(n) * n;
+        if (!(d.norm() > 0)) return;
+        d.normalize();
+        const Eigen::Vector3d d_perp = n.cross(d);
+        double sum = 0;
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Vector3d e = quads.V.row(quads.vertex(f, (k + 1) % 4)) - quads.V.row(quads.vertex(f, k));
+          const double theta = std::atan2(std::abs(e.dot(d_perp)), std::abs(e.dot(d))) * 180 / M_PI;
+          sum += std::min(theta, 90 - theta);
+        }
+        angle_sum[i] = sum / 4;
       });
       for (size_t i = 0; i < quad_faces.size(); ++i) quad_flipped[i] |= facing_away[i];
+      double angle_total = 0;
+      for (const double s : angle_sum)
+        if (s >= 0) {
+          angle_total += s;
+          ++m.n_anisotropic_quads;
+        }
+      if (m.n_anisotropic_quads > 0) m.principal_angle_mean = angle_total / m.n_anisotropic_quads;
 
       std::mt19937 rng(options.seed);
       const std::vector<Point> quad_samples = quad_surface.samples(options.hausdorff_samples, rng);

@@ -3,6 +3,7 @@
 #include <libparam/seamless_param.h>
 #include <libparam/sizing.h>
 
+#include <libcore/curvature.h>
 #include <libcore/predicates.h>
 #include <libcore/read_mesh.h>
 
@@ -36,7 +37,7 @@ double face_area(const core::TriMesh& m, int f) {
 TEST(Sizing, JetFittingFindsTheCurvaturesOfSpheresAndEllipsoids) {
   core::TriMesh sphere = data_mesh("sphere.obj");
   sphere.V *= 2.0;  // radius 2: both principal curvatures 1/2 (convex: positive w.r.t. the outward normal)
-  const VertexCurvature c = estimate_curvature(sphere);
+  const core::VertexCurvature c = core::estimate_curvature(sphere);
   for (int v = 0; v < sphere.n_vertices(); ++v) {
     EXPECT_NEAR(c.k_max[v], 0.5, 0.02) << v;
     EXPECT_NEAR(c.k_min[v], 0.5, 0.02) << v;
@@ -44,7 +45,7 @@ TEST(Sizing, JetFittingFindsTheCurvaturesOfSpheresAndEllipsoids) {
   // Ellipsoid (3, 1, 1): at the tip (±3, 0, 0) both curvatures are a/b² = 3; on the equator
   // x = 0 they are 1 (around x) and b/a² = 1/9 (along x), the larger across the long axis.
   const core::TriMesh e = ellipsoid(3);
-  const VertexCurvature ce = estimate_curvature(e);
+  const core::VertexCurvature ce = core::estimate_curvature(e);
   int tips = 0, equator = 0;
   for (int v = 0; v < e.n_vertices(); ++v) {
     if (std::abs(e.V(v, 0)) > 2.999) {

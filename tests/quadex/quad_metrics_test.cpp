@@ -247,3 +247,41 @@ TEST(QuadMetrics, SamplingIsDeterministic) {
 
 }  // namespace
 }  // namespace quadify::quadex
+
+namespace quadify::quadex {
+namespace {
+
+// An open cylinder of radius 1 and height 4 as a quad grid (n_theta × n_z), its rows turned by
+// `twist` radians per unit of height (a helical grid when twist ≠ 0).
+core::PolyMesh cylinder_quads(int n_theta, int n_z, double twist) {
+  core::PolyMesh m;
+  m.V.resize(n_theta * (n_z + 1), 3);
+  for (int j = 0; j <= n_z; ++j)
+    for (int i = 0; i < n_theta; ++i) {
+      const double z = 4.0 * j / n_z, a = 2 * std::numbers::pi * i / n_theta + twist * z;
+      m.V.row(j * n_theta + i) << std::cos(a), std::sin(a), z;
+    }
+  for (int j = 0; j < n_z; ++j)
+    for (int i = 0; i < n_theta; ++i) {
+      const int a = j * n_theta + i, b = j * n_theta + (i + 1) % n_theta;
+      m.add_face({a, b, b + n_theta, a + n_theta});
+    }
+  return m;
+}
+
+// The cylinder bends around (curvature 1) and not along its axis: a grid of rings and axial lines
+// follows the principal directions; a helical one (axial lines at ~31°) does not.
+TEST(QuadMetrics, PrincipalCurvatureAlignment) {
+  const core::TriMesh reference = core::to_trimesh(cylinder_quads(96, 64, 0));
+  const QuadMetrics aligned = compute_quad_metrics(cylinder_quads(32, 20, 0), &reference);
+  EXPECT_GT(aligned.n_anisotropic_quads, 400);
+  EXPECT_LT(aligned.principal_angle_mean, 3.0);
+  const QuadMetrics helical = compute_quad_metrics(cylinder_quads(32, 20, 0.6), &reference);
+  EXPECT_GT(helical.principal_angle_mean, 10.0);
+  QuadMetricsOptions off;
+  off.curvature_alignment = false;
+  EXPECT_EQ(compute_quad_metrics(cylinder_quads(32, 20, 0), &reference, off).principal_angle_mean, -1);
+}
+
+}  // namespace
+}  // namespace quadify::quadex

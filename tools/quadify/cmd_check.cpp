@@ -117,6 +117,10 @@ nlohmann::json check_quads(const CheckArgs& args, const core::PolyMesh& raw, Pro
                 args.reference.c_str(), m.hausdorff_sym, m.hausdorff_to_ref, m.hausdorff_from_ref, m.mean_dist_sym);
     if (m.feature_capture >= 0)
       std::printf("feature capture %.4f (feature Hausdorff %.4g)\n", m.feature_capture, m.feature_hausdorff);
+    if (m.principal_angle_mean >= 0)
+      std::printf("principal curvature alignment: mean angle %.2f deg over %d quads in anisotropic regions "
+                  "(22.5 = random)\n",
+                  m.principal_angle_mean, m.n_anisotropic_quads);
   }
 
   nlohmann::json j;
@@ -147,6 +151,9 @@ nlohmann::json check_quads(const CheckArgs& args, const core::PolyMesh& raw, Pro
     j["mean_dist_sym"] = number(m.mean_dist_sym);
     j["feature_capture"] = m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json(nullptr);
     j["feature_hausdorff"] = m.feature_hausdorff >= 0 ? number(m.feature_hausdorff) : nlohmann::json(nullptr);
+    j["principal_angle_mean"] =
+        m.principal_angle_mean >= 0 ? number(m.principal_angle_mean) : nlohmann::json(nullptr);
+    j["anisotropic_quads"] = m.n_anisotropic_quads;
   }
   return j;
 }

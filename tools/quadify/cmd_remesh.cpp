@@ -207,7 +207,10 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"hausdorff_sym", number(m.hausdorff_sym)},
                        {"mean_dist_sym", number(m.mean_dist_sym)},
                        {"feature_capture", m.feature_capture >= 0 ? number(m.feature_capture) : nlohmann::json()},
-                       {"feature_hausdorff", m.feature_capture >= 0 ? number(m.feature_hausdorff) : nlohmann::json()}};
+                       {"feature_hausdorff", m.feature_capture >= 0 ? number(m.feature_hausdorff) : nlohmann::json()},
+                       {"principal_angle_mean",
+                        m.principal_angle_mean >= 0 ? number(m.principal_angle_mean) : nlohmann::json()},
+                       {"anisotropic_quads", m.n_anisotropic_quads}};
     // A component smaller than about one quad gets no grid point inside and so no quad: say so
     // rather than let a part of the model vanish silently.
     const int input_components = core::topology_stats(mesh).n_components;

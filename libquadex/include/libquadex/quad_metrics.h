@@ -17,6 +17,9 @@ struct QuadMetricsOptions {
   double feature_angle_deg = 40.0;
   // A feature point counts as captured within this distance of a quad edge (× bbox diagonal).
   double feature_capture_tolerance = 1e-3;
+  // Measure how quad edges follow the reference's principal curvature directions (needs the
+  // curvature estimate of the reference: core::estimate_curvature).
+  bool curvature_alignment = true;
 };
 
 struct QuadMetrics {
@@ -52,6 +55,13 @@ struct QuadMetrics {
   // oriented. Sharp edges are sampled every 1e-3 × diagonal.
   double feature_capture = -1;
   double feature_hausdorff = -1;  // max distance from sharp-edge samples to the nearest quad edge
+  // Alignment with principal curvature directions, in anisotropic regions of the reference (at
+  // the reference vertex nearest the quad: the larger curvature magnitude at least twice the
+  // smaller and at least 4 / bbox diagonal): mean over those quads' edges of the angle between
+  // the edge (in the tangent plane) and the nearest principal direction, in [0°, 45°] (edges at
+  // random: 22.5°); -1 when no quad lies in such a region.
+  double principal_angle_mean = -1;
+  int n_anisotropic_quads = 0;
 };
 
 // Precondition: V finite and face ids in range (any PolyMesh from read_mesh satisfies it).
