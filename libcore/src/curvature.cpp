@@ -1,4 +1,5 @@
 #include <libcore/curvature.h>
+#include <libcore/topology.h>
 
 #define CGAL_EIGEN3_ENABLED 1
 #include <CGAL/Monge_via_jet_fitting.h>
@@ -22,21 +23,6 @@ using JetFitting = CGAL::Monge_via_jet_fitting<Kernel>;
 constexpr int kMinJetPoints = 12;  // a degree-2 jet has 6 coefficients: twice that, for stability
 constexpr int kMaxRings = 4;
 
-// Vertex neighbours (CSR over the face corners).
-std::vector<std::vector<int>> vertex_neighbours(const TriMesh& mesh) {
-  std::vector<std::vector<int>> nb(mesh.n_vertices());
-  for (int f = 0; f < mesh.n_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-      nb[a].push_back(b);
-      nb[b].push_back(a);
-    }
-  for (auto& n : nb) {
-    std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
-  }
-  return nb;
-}
 
 template <class Body>
 void for_each_index(int n, const Body& body) {

@@ -151,6 +151,21 @@ TopologyStats topology_stats(const TriMesh& mesh) {
   return s;
 }
 
+std::vector<std::vector<int>> vertex_neighbours(const TriMesh& mesh) {
+  std::vector<std::vector<int>> nb(mesh.n_vertices());
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      nb[a].push_back(b);
+      nb[b].push_back(a);
+    }
+  for (auto& n : nb) {
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+  }
+  return nb;
+}
+
 std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, double angle_deg) {
   auto normal = [&](int f) {
     const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),

@@ -1,4 +1,5 @@
 #include <libparam/sizing.h>
+#include <libcore/topology.h>
 
 #include <libcore/curvature.h>
 
@@ -14,25 +15,6 @@
 
 
 namespace quadify::param {
-namespace {
-
-// Vertex neighbours (CSR over the face corners).
-std::vector<std::vector<int>> vertex_neighbours(const core::TriMesh& mesh) {
-  std::vector<std::vector<int>> nb(mesh.n_vertices());
-  for (int f = 0; f < mesh.n_faces(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
-      nb[a].push_back(b);
-      nb[b].push_back(a);
-    }
-  for (auto& n : nb) {
-    std::sort(n.begin(), n.end());
-    n.erase(std::unique(n.begin(), n.end()), n.end());
-  }
-  return nb;
-}
-
-}  // namespace
 
 double sized_area(const core::TriMesh& mesh, const std::vector<double>& face_size,
                   const std::vector<Eigen::Matrix3d>& face_metric) {
@@ -144,7 +126,7 @@ std::vector<double> adaptive_face_size(const core::TriMesh& mesh, const Adaptive
   const double half_range = 0.5 * std::log(options.max_ratio);
   std::vector<double> log_size(nv);
   for (int v = 0; v < nv; ++v) log_size[v] = log_length(kappa[v], kappa_ref, half_range);
-  smooth(vertex_neighbours(mesh), options.smoothing_passes, &log_size);
+  smooth(core::vertex_neighbours(mesh), options.smoothing_passes, &log_size);
   std::vector<double> vertex_size(nv);
   for (int v = 0; v < nv; ++v) vertex_size[v] = std::exp(log_size[v]);
   return face_size_from_vertices(mesh, vertex_size);
@@ -161,7 +143,7 @@ std::vector<Eigen::Matrix3d> adaptive_face_metric(const core::TriMesh& mesh,
   // of lesser curvature may get up to √max_ratio longer edges than that.
   const double kappa_ref = weighted_median(kappa, vertex_areas(mesh));
   const double half_range = 0.5 * std::log(options.max_ratio);
-  const std::vector<std::vector<int>> nb = vertex_neighbours(mesh);
+  const std::vector<std::vector<int>> nb = core::vertex_neighbours(mesh);
   // Per vertex: log lengths along the two principal directions, and the directions' outer
   // products (sign-free, so they average across neighbours).
   std::vector<Eigen::Vector2d> log_len(nv, Eigen::Vector2d::Zero());

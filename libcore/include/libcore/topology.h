@@ -70,6 +70,9 @@ struct CreaseOptions {
 // Sharp edges (as sharp_edges) that pass the crease filter of `options`, in increasing order.
 std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, const CreaseOptions& options);
 
+// The vertices joined to each vertex by an edge (#V lists, sorted, without duplicates).
+std::vector<std::vector<int>> vertex_neighbours(const TriMesh& mesh);
+
 // Topological statistics of any triangle mesh (also non-manifold ones: counts only).
 TopologyStats topology_stats(const TriMesh& mesh);
 
