@@ -23,7 +23,6 @@ using JetFitting = CGAL::Monge_via_jet_fitting<Kernel>;
 constexpr int kMinJetPoints = 12;  // a degree-2 jet has 6 coefficients: twice that, for stability
 constexpr int kMaxRings = 4;
 
-
 template <class Body>
 void for_each_index(int n, const Body& body) {
 #ifdef QUADIFY_WITH_TBB

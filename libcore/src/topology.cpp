@@ -151,6 +151,15 @@ TopologyStats topology_stats(const TriMesh& mesh) {
   return s;
 }
 
+namespace {
+// Twice the area times the unit normal of face f (zero for a degenerate face).
+Eigen::Vector3d face_area_normal(const TriMesh& mesh, int f) {
+  const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
+                        c = mesh.V.row(mesh.F(f, 2));
+  return (b - a).cross(c - a);
+}
+}  // namespace
+
 std::vector<std::vector<int>> vertex_neighbours(const TriMesh& mesh) {
   std::vector<std::vector<int>> nb(mesh.n_vertices());
   for (int f = 0; f < mesh.n_faces(); ++f)
@@ -167,11 +176,7 @@ std::vector<std::vector<int>> vertex_neighbours(const TriMesh& mesh) {
 }
 
 std::vector<int> sharp_edges(const TriMesh& mesh, const EdgeTopology& topo, double angle_deg) {
-  auto normal = [&](int f) {
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
-                          c = mesh.V.row(mesh.F(f, 2));
-    return Eigen::Vector3d((b - a).cross(c - a));
-  };
+  auto normal = [&](int f) { return face_area_normal(mesh, f); };
   const double cos_threshold = std::cos(angle_deg * std::numbers::pi / 180.0);
   std::vector<int> sharp;
   for (int e = 0; e < topo.n_edges(); ++e) {
@@ -190,11 +195,7 @@ std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, con
   const int ne = topo.n_edges(), nv = mesh.n_vertices();
   // Dihedral angle (degrees) of every interior edge; 0 where a face is degenerate.
   std::vector<double> dihedral(ne, 0);
-  auto normal = [&](int f) {
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)),
-                          c = mesh.V.row(mesh.F(f, 2));
-    return Eigen::Vector3d((b - a).cross(c - a));
-  };
+  auto normal = [&](int f) { return face_area_normal(mesh, f); };
   for (int e = 0; e < ne; ++e) {
     const int h = topo.edge_halfedge[e], t = topo.twin[h];
     if (t < 0) continue;

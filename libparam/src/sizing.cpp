@@ -37,20 +37,16 @@ std::vector<double> face_size_from_vertices(const core::TriMesh& mesh,
       throw std::invalid_argument("size field value " + std::to_string(v + 1) +
                                   " is not a positive number");
   const int nf = mesh.n_faces();
-  std::vector<double> size(nf), area(nf);
-  double sum_area = 0, sum_sized = 0;
+  std::vector<double> size(nf);
   for (int f = 0; f < nf; ++f) {
     double log_sum = 0;
     for (int k = 0; k < 3; ++k) log_sum += std::log(vertex_size[mesh.F(f, k)]);
     size[f] = std::exp(log_sum / 3);
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
-                          p2 = mesh.V.row(mesh.F(f, 2));
-    area[f] = 0.5 * (p1 - p0).cross(p2 - p0).norm();
-    sum_area += area[f];
-    sum_sized += area[f] / (size[f] * size[f]);
   }
-  if (sum_area > 0 && sum_sized > 0) {
-    const double c = std::sqrt(sum_sized / sum_area);
+  // Normalize (as adaptive_face_metric does): Σ area/size² = Σ area.
+  const double area = sized_area(mesh, {}, {}), sized = sized_area(mesh, size, {});
+  if (area > 0 && sized > 0) {
+    const double c = std::sqrt(sized / area);
     for (double& s : size) s *= c;
   }
   return size;
