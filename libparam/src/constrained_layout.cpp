@@ -22,6 +22,7 @@
 #include <string>
 
 #include "constraint_elimination.h"
+#include "direction_alignment.h"
 #include "distortion_energy.h"
 #include "cut_layout.h"
 #include "layout_optimizer.h"
@@ -415,6 +416,11 @@ struct PinnedLayout::Impl {
   // Quadratic penalty w·Σ (y_j − target)² of PinnedLayout::pin's homotopy (free variables).
   std::vector<std::pair<int, double>> penalty;
   double penalty_weight = 0;
+  // Direction alignment: per face the image coefficients (α, β) of its direction (zero: none),
+  // the penalized UV coordinate and the weight (see PinnedLayoutOptions::face_direction).
+  std::vector<Eigen::Vector2d> dir_coef;
+  std::vector<int> dir_axis;
+  double dir_weight = 0;
   std::vector<double> face_value;
   std::vector<Eigen::VectorXd> face_g;
   std::vector<Eigen::MatrixXd> face_h;
@@ -461,10 +467,25 @@ struct PinnedLayout::Impl {
       const DensityEval ev = evaluate_density(density, power, J, derivatives, true);
       const double a = domain.area[f];
       face_value[f] = ev.finite ? a * ev.value : std::numeric_limits<double>::infinity();
+      // Alignment term w·a·q², q = Σ_j c_j·X(k, j) (local edge-vector variable 2j + k).
+      const bool aligned = !dir_coef.empty() && dir_coef[f].squaredNorm() > 0;
+      double q = 0;
+      if (aligned) {
+        const Eigen::Matrix2d X = edge_matrix(xx, f);
+        q = dir_coef[f].x() * X(dir_axis[f], 0) + dir_coef[f].y() * X(dir_axis[f], 1);
+        face_value[f] += dir_weight * a * q * q;
+      }
       if (!derivatives || !ev.finite) return;
       Eigen::Vector4d g4;
       Eigen::Matrix4d h4;
       edge_vector_derivatives(domain.rest_inverse[f], a, ev, &g4, &h4);
+      if (aligned)
+        for (int j = 0; j < 2; ++j) {
+          g4[2 * j + dir_axis[f]] += 2 * dir_weight * a * q * dir_coef[f][j];
+          for (int i = 0; i < 2; ++i)
+            h4(2 * j + dir_axis[f], 2 * i + dir_axis[f]) +=
+                2 * dir_weight * a * dir_coef[f][j] * dir_coef[f][i];
+        }
       const Face& el = faces[f];
       face_g[f].noalias() = el.M.transpose() * g4;
       face_h[f].noalias() = el.M.transpose() * h4 * el.M;
@@ -663,6 +684,20 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   m.red = elim.reduction(xi);
   m.y = m.red.restrict(xi);
   m.x = m.red.expand(m.y);
+  if (!options.face_direction.empty() && options.direction_weight > 0) {
+    if (static_cast<int>(options.face_direction.size()) != nf)
+      return core::Status::invalid_input("PinnedLayout: face_direction needs one vector per face");
+    const DirectionField field = make_direction_field(mesh, m.domain, options.face_direction);
+    m.dir_coef.assign(nf, Eigen::Vector2d::Zero());
+    m.dir_axis.assign(nf, 0);
+    m.dir_weight = options.direction_weight;
+    for (int i = 0; i < field.size(); ++i) {
+      const int f = field.face[i];
+      m.dir_coef[f] = field.coef[i];
+      const Eigen::Vector2d img = m.edge_matrix(m.x, f) * field.coef[i];
+      m.dir_axis[f] = std::abs(img.x()) >= std::abs(img.y()) ? 1 : 0;
+    }
+  }
   m.state.assign(m.n(), 0);
   if (const int flips = count_flipped(m.domain, m.x); flips > 0)
     return core::Status::invalid_input("PinnedLayout: " + std::to_string(flips) +

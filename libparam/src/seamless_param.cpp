@@ -3,6 +3,7 @@
 #include "cone_pairs.h"
 #include "constraint_elimination.h"
 #include "cut_layout.h"
+#include "direction_alignment.h"
 #include "feature_alignment.h"
 #include "layout_optimizer.h"
 #include "local_estimation.h"
@@ -86,7 +87,8 @@ double batch_threshold(const ParamOptions& o, int i) {
 ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options,
                               const std::vector<std::array<int, 2>>& feature_edges,
                               const std::vector<double>& face_size,
-                              const std::vector<Eigen::Matrix3d>& face_metric) {
+                              const std::vector<Eigen::Matrix3d>& face_metric,
+                              const std::vector<Eigen::Vector3d>& face_direction) {
   ComponentOutput out;
   const auto t0 = Clock::now();
   const CutMesh cut = cut_along_dual_tree(mesh, 0, face_size, face_metric);
@@ -110,11 +112,25 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     fs = make_feature_set(cut, edges);
   }
   out.stats.n_feature_edges = fs.size();
-  if (fs.size() > 0 && options.feature_global_rotation) {
-    const double angle = feature_rotation_angle(cut, x, fs);
+  // Directions to align (paper 6.1), as soft penalty rows re-labeled from the current layout.
+  const DirectionField directions = make_direction_field(mesh, domain, face_direction);
+  out.stats.n_direction_faces = directions.size();
+  std::vector<SparseRow> dir_rows;
+  const std::vector<SparseRow>* dir_penalty = nullptr;
+  auto update_direction_rows = [&] {
+    if (directions.size() == 0) return;
+    dir_rows = direction_rows(domain, directions, x);
+    dir_penalty = &dir_rows;
+  };
+  if ((fs.size() > 0 && options.feature_global_rotation) || directions.size() > 0) {
+    const double angle = fs.size() > 0 && options.feature_global_rotation
+                             ? feature_rotation_angle(cut, x, fs)
+                             : direction_rotation_angle(domain, directions, x);
     const Eigen::Rotation2Dd rot(-angle);
     for (int c = 0; c < cut.n_copies(); ++c) x.segment<2>(2 * c) = rot * x.segment<2>(2 * c);
   }
+  out.stats.direction_angle_initial =
+      directions.size() > 0 ? direction_angle_mean(domain, directions, x) : 0;
   std::vector<int> label(fs.size(), kUnlabeled);
   std::vector<SparseRow> feature_rows;  // rows of the labeled features, in labeling order
   out.stats.seconds_cut = seconds_since(t0);
@@ -130,6 +146,27 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   for (double a : cut.area) total_area += a;
 
   const auto [density, power] = energy_density(options.energy);
+
+  // With directions, the unconstrained layout first bends towards them, so that the matchings are
+  // measured on an aligned layout (the layout plays the part of a cross field).
+  if (directions.size() > 0) {
+    for (int pass = 0; pass < 2; ++pass) {
+      update_direction_rows();
+      LayoutProblem problem(domain, red, dir_penalty);
+      Eigen::VectorXd y = red.restrict(x);
+      OptimizeSettings st;
+      st.density = density;
+      st.power = power;
+      st.max_iterations = options.max_newton_iters;
+      st.relative_tolerance = kBatchTolerance;
+      st.penalty_weight = options.direction_weight;
+      const OptimizeReport rep = optimize_layout(problem, st, &y);
+      out.stats.total_iterations += rep.iterations;
+      out.stats.n_batch_iterations += rep.iterations;
+      add_timers(rep.timers, &out.stats);
+      if (rep.status.is_ok()) x = red.expand(y);
+    }
+  }
 
   const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
   const int n_steps =
@@ -318,7 +355,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
     red_problem.reset();
     red = std::move(tr.reduction);
-    red_problem = std::make_unique<LayoutProblem>(domain, red);
+    update_direction_rows();
+    red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
     if (!tr.status.is_ok()) {
       out.status = tr.status;
     }
@@ -330,6 +368,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // With kTau the L^p continuation follows and converges the final layout.
     st.relative_tolerance =
         last && options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
+    st.penalty_weight = options.direction_weight;
     const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
     out.stats.total_iterations += rep.iterations;
     out.stats.n_batch_iterations += rep.iterations;
@@ -393,6 +432,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         st.power = power;
         st.max_iterations = options.max_newton_iters;
         st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
+        update_direction_rows();
+        st.penalty_rows = dir_penalty;
+        st.penalty_weight = options.direction_weight;
         const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
         out.stats.total_iterations += rep.iterations;
         out.stats.n_batch_iterations += rep.iterations;
@@ -422,6 +464,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   if (options.energy == Energy::kTau) {
     const auto to = Clock::now();
+    if (directions.size() > 0) {
+      update_direction_rows();
+      red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
+    }
     if (!red_problem) red_problem = std::make_unique<LayoutProblem>(domain, red);
     for (double p : kTauPowers) {
       if (options.progress) options.progress("tau", static_cast<int>(p), static_cast<int>(std::end(kTauPowers)[-1]));
@@ -431,6 +477,20 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.power = p;
       st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
       st.relative_tolerance = p == std::end(kTauPowers)[-1] ? kFinalTolerance : kTauStageTolerance;
+      // d(SD/4)^p = (p/4)·(SD/4)^(p−1)·dSD: scale the alignment by the area-weighted mean of that
+      // factor in the current layout, so that it keeps its balance with the distortion of the
+      // typical face (the continuation otherwise raises the price of distortion p-fold and more).
+      if (directions.size() > 0) {
+        const Eigen::VectorXd sd =
+            face_densities(domain, x, Density::kSymmetricDirichlet, 1);
+        double factor = 0, area = 0;
+        for (int f = 0; f < domain.n_faces(); ++f)
+          if (std::isfinite(sd[f])) {
+            factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
+            area += domain.area[f];
+          }
+        st.penalty_weight = options.direction_weight * p / 4 * (area > 0 ? factor / area : 1);
+      }
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
@@ -441,6 +501,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     out.stats.seconds_optimize += seconds_since(to);
   }
 
+  if (directions.size() > 0) out.stats.direction_angle = direction_angle_mean(domain, directions, x);
   out.stats.n_free_variables = red.n_free();
   out.stats.max_constraint_fill = elim.max_expression_length();
   // Output: corner UVs, seams, cones, metrics.
@@ -532,6 +593,15 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
                                            " is not finite or flattens the face");
     }
   }
+  if (!o.face_direction.empty()) {
+    if (static_cast<int>(o.face_direction.size()) != mesh.n_faces())
+      return core::Status::invalid_input("face_direction has " + std::to_string(o.face_direction.size()) +
+                                         " vectors for " + std::to_string(mesh.n_faces()) + " faces");
+    for (const Eigen::Vector3d& d : o.face_direction)
+      if (!d.allFinite()) return core::Status::invalid_input("face_direction values must be finite");
+  }
+  if (!(o.direction_weight >= 0) || !std::isfinite(o.direction_weight))
+    return core::Status::invalid_input("direction_weight must be finite and non-negative");
   if (!mesh.V.allFinite()) return core::Status::invalid_input("mesh has non-finite vertex coordinates");
   for (int f = 0; f < mesh.n_faces(); ++f) {
     for (int k = 0; k < 3; ++k)
@@ -605,10 +675,13 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   }
   std::vector<std::vector<double>> sub_size(n_comp);
   std::vector<std::vector<Eigen::Matrix3d>> sub_metric(n_comp);
+  std::vector<std::vector<Eigen::Vector3d>> sub_direction(n_comp);
   for (int c = 0; c < n_comp; ++c)
     for (const int f : sub_faces[c]) {
       if (!options.face_size.empty()) sub_size[c].push_back(options.face_size[f]);
       if (!options.face_metric.empty()) sub_metric[c].push_back(options.face_metric[f]);
+      if (!options.face_direction.empty() && options.direction_weight > 0)
+        sub_direction[c].push_back(options.face_direction[f]);
     }
   std::vector<ComponentOutput> outs(n_comp);
   // Components may run on worker threads: serialize the progress callback.
@@ -626,12 +699,13 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   plain_options.align_boundaries = false;
   std::vector<char> fell_back(n_comp, 0);
   auto work = [&](int c) {
-    outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c], sub_metric[c]);
+    outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c], sub_metric[c],
+                            sub_direction[c]);
     if (outs[c].status.is_ok() || outs[c].status.code() == core::StatusCode::kInvalidInput ||
         outs[c].stats.n_feature_edges == 0)
       return;
     const int n_features = outs[c].stats.n_feature_edges;
-    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c]);
+    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c], sub_direction[c]);
     outs[c].stats.n_feature_edges = n_features;
     outs[c].stats.n_disabled_features = n_features;
     fell_back[c] = 1;
@@ -666,6 +740,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_disabled_features += o.stats.n_disabled_features;
     st.n_feature_patches += o.stats.n_feature_patches;
     st.feature_alignment_error = std::max(st.feature_alignment_error, o.stats.feature_alignment_error);
+    st.n_direction_faces += o.stats.n_direction_faces;
     st.n_seam_edges += o.stats.n_seam_edges;
     st.n_cones += o.stats.n_cones;
     st.n_patches += o.stats.n_patches;
@@ -697,6 +772,14 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.max_element_variables = std::max(st.max_element_variables, o.stats.max_element_variables);
     st.max_sum_sq_element_variables =
         std::max(st.max_sum_sq_element_variables, o.stats.max_sum_sq_element_variables);
+  }
+  // Direction angles: weighted by the components' numbers of direction faces.
+  if (st.n_direction_faces > 0) {
+    for (const ComponentOutput& o : outs) {
+      st.direction_angle += o.stats.direction_angle * o.stats.n_direction_faces / st.n_direction_faces;
+      st.direction_angle_initial +=
+          o.stats.direction_angle_initial * o.stats.n_direction_faces / st.n_direction_faces;
+    }
   }
   const double diag = core::bbox_diagonal(mesh.V);
   if (result.status.is_ok() && st.seam_residual > options.seam_tol * diag)

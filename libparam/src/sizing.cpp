@@ -192,4 +192,43 @@ std::vector<Eigen::Matrix3d> adaptive_face_metric(const core::TriMesh& mesh,
   return metric;
 }
 
+std::vector<Eigen::Vector3d> principal_face_directions(const core::TriMesh& mesh,
+                                                       const PrincipalDirectionOptions& options) {
+  const int nv = mesh.n_vertices(), nf = mesh.n_faces();
+  std::vector<Eigen::Vector3d> direction(nf, Eigen::Vector3d::Zero());
+  if (nf == 0) return direction;
+  const core::VertexCurvature c = core::estimate_curvature(mesh);
+  const double diag = core::bbox_diagonal(mesh.V);
+  std::vector<char> anisotropic(nv, 0);
+  std::vector<Eigen::Matrix3d> frame(nv, Eigen::Matrix3d::Zero());
+  for (int v = 0; v < nv; ++v) {
+    const Eigen::Vector3d d1 = c.d_max.row(v), d2 = c.d_min.row(v);
+    if (d1.squaredNorm() == 0) continue;
+    const double k1 = std::abs(c.k_max[v]), k2 = std::abs(c.k_min[v]);
+    const double big = std::max(k1, k2), small = std::min(k1, k2);
+    anisotropic[v] = big >= options.min_ratio * small && big * diag >= options.min_curvature;
+    // +1 along the direction of larger magnitude, −1 across it (sign-free, averages).
+    frame[v] = k1 >= k2 ? Eigen::Matrix3d(d1 * d1.transpose() - d2 * d2.transpose())
+                        : Eigen::Matrix3d(d2 * d2.transpose() - d1 * d1.transpose());
+  }
+  smooth(core::vertex_neighbours(mesh), options.smoothing_passes, &frame);
+  for (int f = 0; f < nf; ++f) {
+    if (!anisotropic[mesh.F(f, 0)] || !anisotropic[mesh.F(f, 1)] || !anisotropic[mesh.F(f, 2)])
+      continue;
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                          p2 = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0).normalized();
+    if (!n.allFinite()) continue;
+    Eigen::Matrix3d fr = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < 3; ++k) fr += frame[mesh.F(f, k)] / 3.0;
+    const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - n * n.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(tangent * fr * tangent);
+    // Coherent directions: the averaged frame keeps a clear +1/−1 split (1 when all agree).
+    if (es.eigenvalues()(2) - es.eigenvalues()(0) < 1) continue;
+    const Eigen::Vector3d d = tangent * es.eigenvectors().col(2);
+    if (d.norm() > 1e-9) direction[f] = d.normalized();
+  }
+  return direction;
+}
+
 }  // namespace quadify::param

@@ -717,6 +717,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   lopt.energy = options.energy;
   lopt.face_size = options.face_size;
   lopt.face_metric = options.face_metric;
+  lopt.face_direction = options.face_direction;
+  lopt.direction_weight = options.direction_weight;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
   std::vector<char> feature_coords;

@@ -301,10 +301,8 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
   EXPECT_EQ(report["quads"]["components_lost"], 1);
 }
 
-// --adaptive: on an ellipsoid (3, 1, 1) the quads at the tips (curvature 3) come out smaller
-// than around the middle (curvature 1), more so than the map's own distortion makes them;
-// --anisotropic: quads around the middle stretch along the axis.
-TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
+// tests/data/sphere.obj stretched to the ellipsoid (3, 1, 1), written to `path`.
+void write_ellipsoid(const fs::path& path) {
   std::ostringstream obj;
   {
     std::istringstream in(slurp(data_path("sphere.obj")));
@@ -319,8 +317,15 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
       }
     }
   }
+  write_text(path, obj.str());
+}
+
+// --adaptive: on an ellipsoid (3, 1, 1) the quads at the tips (curvature 3) come out smaller
+// than around the middle (curvature 1), more so than the map's own distortion makes them;
+// --anisotropic: quads around the middle stretch along the axis.
+TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   const fs::path in = dir_ / "ellipsoid.obj";
-  write_text(in, obj.str());
+  write_ellipsoid(in);
   // Mean quad edge at the tips (|x| > 2.5) over the middle (|x| < 0.5), and in the middle, mean
   // edge along the long axis over around it.
   struct Shape {
@@ -387,6 +392,40 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   const Shape anisotropic = remesh("--adaptive --anisotropic");
   EXPECT_GT(anisotropic.along_over_around, 1.4) << "along/around " << anisotropic.along_over_around;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["param"]["sizing"]["mode"], "adaptive-anisotropic");
+}
+
+// --align-curvature (paper 6.1): around the middle of the ellipsoid the quad edges follow the
+// principal directions (rings and meridians); without it they lie at about the random 22.5°.
+TEST_F(CliTest, CurvatureAlignmentTurnsQuadsOntoPrincipalDirections) {
+  const fs::path in = dir_ / "ellipsoid.obj";
+  write_ellipsoid(in);
+  auto remesh = [&](const std::string& extra) {
+    std::string args;
+    args.append("'").append(in.string()).append("' -o '").append((dir_ / "q.obj").string());
+    args.append("' --target-faces 600 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
+    const CliRun r = quadify(args + extra, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    EXPECT_EQ(report["quads"]["non_quads"], 0);
+    EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+    EXPECT_GT(report["quads"]["anisotropic_quads"].get<int>(), 100);
+    return report;
+  };
+  const auto plain = remesh("");
+  EXPECT_TRUE(plain["param"]["curvature_alignment"].is_null());
+  const auto aligned = remesh("--align-curvature");
+  const double before = plain["quads"]["principal_angle_mean"].get<double>();
+  const double after = aligned["quads"]["principal_angle_mean"].get<double>();
+  EXPECT_GT(before, 12);
+  EXPECT_LT(after, 8) << "without the mode: " << before;
+  const auto& ca = aligned["param"]["curvature_alignment"];
+  EXPECT_GT(ca["faces"].get<int>(), 500);
+  EXPECT_LT(ca["angle_deg"].get<double>(), ca["angle_initial_deg"].get<double>());
+  const CliRun bad = quadify("'" + in.string() + "' -o '" + (dir_ / "b.obj").string() +
+                                 "' --align-curvature --curvature-weight -1",
+                             dir_);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_FALSE(fs::exists(dir_ / "b.obj"));
 }
 
 // A size field file: one positive number per input vertex; a bad line or count is bad input.

@@ -36,8 +36,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
   options.threads = common.threads;
   const FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &options);
   SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
-  options.face_size = std::move(sizing.face_size);
-  options.face_metric = std::move(sizing.face_metric);
+  sizing.apply_to(&options);
   options.progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
   };
@@ -65,6 +64,9 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                 "%.2f s\n",
                 m.tau, m.n_flipped, m.n_cones, m.n_seam_edges, m.seam_residual_abs, s.n_patches, s.n_improved,
                 s.seconds_total);
+    if (s.n_direction_faces > 0)
+      std::printf("curvature alignment: %d faces, mean angle to the axes %.1f deg (unaligned %.1f deg)\n",
+                  s.n_direction_faces, s.direction_angle, s.direction_angle_initial);
     if (s.n_feature_edges > 0)
       std::printf("features: %d edges, %d aligned, %d disabled\n", s.n_feature_edges, s.n_aligned_features,
                   s.n_disabled_features);
@@ -99,6 +101,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"seam_residual", number(s.seam_residual)},
                      {"features", feature_json(feature_input, s)},
                      {"sizing", sizing.report},
+                     {"curvature_alignment", direction_json(sizing, s)},
                      {"seconds_cut", s.seconds_cut},
                      {"seconds_optimize", s.seconds_optimize},
                      {"seconds_local_estimation", s.seconds_local_estimation},

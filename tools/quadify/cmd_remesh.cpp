@@ -60,10 +60,11 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &param_options);
   const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
-  param_options.face_size = sizing.face_size;
+  sizing.apply_to(&param_options);
   quantize_options.face_size = sizing.face_size;
-  param_options.face_metric = sizing.face_metric;
   quantize_options.face_metric = sizing.face_metric;
+  quantize_options.face_direction = sizing.face_direction;
+  quantize_options.direction_weight = sizing.direction_weight;
   // Boundaries as explicit feature edges, so that curves too small for the density (tiny holes,
   // short creases) can be left unaligned.
   if (param_options.align_boundaries) {
@@ -159,6 +160,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                      {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
                      {"features", feature_json(feature_input, ps)},
                      {"sizing", sizing.report},
+                     {"curvature_alignment", direction_json(sizing, ps)},
                      {"seconds", ps.seconds_total}};
   const quantize::QuantizeStats& qs = integer_map.stats;
   report["quantize"] = {{"scale", qs.scale},          {"target_faces", args.target_faces},

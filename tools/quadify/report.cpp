@@ -306,11 +306,41 @@ void add_sizing_options(CLI::App& app, SizingArgs* a) {
                  "line, in the input's vertex order ('#' starts a comment); only ratios matter")
       ->type_name("FILE")
       ->excludes(adaptive);
+  app.add_flag("--align-curvature", a->align_curvature,
+               "Align quad edges with the principal curvature directions where the surface is "
+               "clearly anisotropic (larger curvature at least twice the smaller and at least 4 / "
+               "bbox diagonal), as a soft term of the layout energy (paper 6.1)");
+  app.add_option("--curvature-weight", a->curvature_weight,
+                 "With --align-curvature: weight of the alignment against distortion (higher: "
+                 "closer alignment, more distortion)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1000.0));
+}
+
+void SizingInput::apply_to(param::ParamOptions* options) const {
+  options->face_size = face_size;
+  options->face_metric = face_metric;
+  options->face_direction = face_direction;
+  options->direction_weight = direction_weight;
+}
+
+nlohmann::json direction_json(const SizingInput& input, const param::ParamStats& stats) {
+  if (input.face_direction.empty()) return nullptr;
+  return {{"faces", stats.n_direction_faces},
+          {"weight", input.direction_weight},
+          {"angle_initial_deg", number(stats.direction_angle_initial)},
+          {"angle_deg", number(stats.direction_angle)}};
 }
 
 SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, Progress& progress) {
   SizingInput out;
   const core::TriMesh& mesh = loaded.repaired.mesh;
+  if (args.align_curvature) {
+    progress.begin("curvature");
+    out.face_direction = param::principal_face_directions(mesh);
+    out.direction_weight = args.curvature_weight;
+    progress.end();
+  }
   if (args.adaptive) {
     progress.begin("sizing");
     param::AdaptiveSizingOptions o;

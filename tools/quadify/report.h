@@ -116,6 +116,8 @@ struct SizingArgs {
   double max_ratio = 4;      // --adaptive-ratio
   bool anisotropic = false;  // --anisotropic: per-direction lengths (param::adaptive_face_metric)
   std::string size_file;     // --size-field FILE: one relative edge length per input vertex
+  bool align_curvature = false;  // --align-curvature: param::principal_face_directions
+  double curvature_weight = 3;   // --curvature-weight: ParamOptions::direction_weight
 };
 void add_sizing_options(CLI::App& app, SizingArgs* args);
 // Per-face sizes of the repaired mesh (empty: uniform) and their report. Throws CliError naming
@@ -123,8 +125,14 @@ void add_sizing_options(CLI::App& app, SizingArgs* args);
 struct SizingInput {
   std::vector<double> face_size;
   std::vector<Eigen::Matrix3d> face_metric;
+  std::vector<Eigen::Vector3d> face_direction;  // --align-curvature (empty: off)
+  double direction_weight = 3;
   nlohmann::json report;
+  // Sets the sizing and alignment fields of the parametrization options.
+  void apply_to(param::ParamOptions* options) const;
 };
+// The "curvature_alignment" part of a report (null when off).
+nlohmann::json direction_json(const SizingInput& input, const param::ParamStats& stats);
 SizingInput apply_sizing_args(const SizingArgs& args, const LoadedMesh& loaded, Progress& progress);
 
 nlohmann::json to_json(const core::RepairReport& report);

@@ -148,6 +148,11 @@ struct PinnedLayoutOptions {
   // alignment x_b[c] − x_a[c] = 0, eliminated after the seam rows (dependent ones are dropped).
   // The start x0 must satisfy them.
   std::vector<AffineRow> extra_rows;
+  // Direction alignment (param::ParamOptions::face_direction and direction_weight): #F 3D
+  // directions or empty. Each face's energy gets weight·area·(component of the direction's image
+  // across the UV axis it is nearest to in x0)²; the axis is fixed at init.
+  std::vector<Eigen::Vector3d> face_direction;
+  double direction_weight = 3;
 };
 
 // Outcome of PinnedLayout::pin: targets that were reached flip-free are pinned; the others stay

@@ -36,6 +36,24 @@ struct AdaptiveSizingOptions {
 [[nodiscard]] std::vector<Eigen::Matrix3d> adaptive_face_metric(
     const core::TriMesh& mesh, const AdaptiveSizingOptions& options = {});
 
+// Where principal curvature directions are prominent (paper section 6.1: "in places where they
+// were prominent").
+struct PrincipalDirectionOptions {
+  // A vertex is anisotropic when its larger principal curvature magnitude is at least min_ratio
+  // times the smaller one and at least min_curvature / (bounding-box diagonal): the same regions
+  // as the quad metrics' principal-direction measure (quadex::QuadMetrics::principal_angle_mean).
+  double min_ratio = 2;
+  double min_curvature = 4;
+  // Passes of averaging the directions (as outer products, sign-free) over vertex neighbours.
+  int smoothing_passes = 4;
+};
+
+// Per face the direction of larger principal curvature magnitude (a unit tangent vector; the
+// other direction is the cross's other arm) where all three vertices are anisotropic and the
+// smoothed directions agree, zero elsewhere: the input of ParamOptions::face_direction.
+[[nodiscard]] std::vector<Eigen::Vector3d> principal_face_directions(
+    const core::TriMesh& mesh, const PrincipalDirectionOptions& options = {});
+
 // Per-vertex relative edge lengths (#V positive values) → per-face sizes: the geometric mean of
 // the face's corners, normalized so that Σ area/size² = Σ area (the map's area, and so the quad
 // count of a target, is unchanged). Throws std::invalid_argument on a wrong count or a value that

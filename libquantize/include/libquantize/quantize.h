@@ -47,6 +47,10 @@ struct QuantizeOptions {
   // the CLI's are, leaves the quad count where the target puts it).
   std::vector<double> face_size;
   std::vector<Eigen::Matrix3d> face_metric;  // as param::ParamOptions::face_metric (or empty)
+  // Direction alignment kept through the re-optimizations: as param::ParamOptions::face_direction
+  // and direction_weight (or empty).
+  std::vector<Eigen::Vector3d> face_direction;
+  double direction_weight = 3;
   // Wall-clock limit of the quantization in seconds (0 = none). When it is exceeded the result
   // is kNotConverged with a message naming the scale, the stage and what to try.
   double time_budget_seconds = 0;
