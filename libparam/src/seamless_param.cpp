@@ -54,6 +54,10 @@ constexpr int kTauStageIterations = 15;
 // Newton-decrement stop of the intermediate stages: each only hands its layout to the next
 // exponent; the last stage converges to kFinalTolerance.
 constexpr double kTauStageTolerance = 1e-5;
+// Alg. 3: largest penalty weight (× area / Σ feature edge²) of the soft feature stages, and the
+// extra ×10 stages after the L^p continuation.
+constexpr double kMaxSoftFeatureWeight = 1e9;
+constexpr int kSoftTightenStages = 4;
 
 struct ComponentOutput {
   core::Status status;
@@ -115,11 +119,22 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   // Directions to align (paper 6.1), as soft penalty rows re-labeled from the current layout.
   const DirectionField directions = make_direction_field(mesh, domain, face_direction);
   out.stats.n_direction_faces = directions.size();
+  // Penalty rows of the layout energy, weights folded in: the directions' (×√direction_weight,
+  // re-labeled from the current layout) and, with Alg. 3, the soft features' (×√soft_weight).
   std::vector<SparseRow> dir_rows;
   const std::vector<SparseRow>* dir_penalty = nullptr;
+  std::vector<SparseRow> soft_rows;  // unit-weight rows of the soft-aligned features
+  double soft_weight = 0;
   auto update_direction_rows = [&] {
-    if (directions.size() == 0) return;
-    dir_rows = direction_rows(domain, directions, x);
+    if (directions.size() == 0 && soft_rows.empty()) return;
+    dir_rows = directions.size() > 0 ? direction_rows(domain, directions, x) : std::vector<SparseRow>{};
+    const double sd = std::sqrt(options.direction_weight), sf = std::sqrt(soft_weight);
+    for (SparseRow& row : dir_rows)
+      for (auto& entry : row.entries) entry.second *= sd;
+    for (const SparseRow& row : soft_rows) {
+      dir_rows.push_back(row);
+      for (auto& entry : dir_rows.back().entries) entry.second *= sf;
+    }
     dir_penalty = &dir_rows;
   };
   if ((fs.size() > 0 && options.feature_global_rotation) || directions.size() > 0) {
@@ -159,7 +174,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.power = power;
       st.max_iterations = options.max_newton_iters;
       st.relative_tolerance = kBatchTolerance;
-      st.penalty_weight = options.direction_weight;
+      st.penalty_weight = 1;
       const OptimizeReport rep = optimize_layout(problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_batch_iterations += rep.iterations;
@@ -168,6 +183,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
   }
 
+  const bool soft_features = options.feature_mode == FeatureMode::kAfterRounding;
   const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
   const int n_steps =
       static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
@@ -188,7 +204,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     std::vector<int> fbatch;  // features labeled in this batch
     std::vector<double> fmeasure(fs.size(), 0);
-    for (int i = 0; i < fs.size(); ++i) {
+    for (int i = 0; i < (soft_features ? 0 : fs.size()); ++i) {
       if (label[i] != kUnlabeled) continue;
       fmeasure[i] = feature_measure(cut, x, fs.halfedge[i]);
       const double err = std::abs(fmeasure[i] - std::round(fmeasure[i]));
@@ -368,7 +384,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // With kTau the L^p continuation follows and converges the final layout.
     st.relative_tolerance =
         last && options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
-    st.penalty_weight = options.direction_weight;
+    st.penalty_weight = 1;
     const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
     out.stats.total_iterations += rep.iterations;
     out.stats.n_batch_iterations += rep.iterations;
@@ -434,7 +450,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
         update_direction_rows();
         st.penalty_rows = dir_penalty;
-        st.penalty_weight = options.direction_weight;
+        st.penalty_weight = 1;
         const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
         out.stats.total_iterations += rep.iterations;
         out.stats.n_batch_iterations += rep.iterations;
@@ -462,9 +478,83 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     out.stats.seconds_optimize += seconds_since(to);
   }
+  // Alg. 3: label every feature now (nearest axis, local estimation where uncertain, the τ bound
+  // and the wedge check as in Alg. 2), then pull them onto their axes with a penalty raised ×10
+  // per stage until the alignment error is within soft_feature_tolerance.
+  auto soft_error = [&] {
+    double err = 0;
+    for (int i = 0; i < fs.size(); ++i) {
+      if (label[i] != 0 && label[i] != 1) continue;
+      const int h = fs.halfedge[i];
+      const int a = cut.corner_copy[h], b = cut.corner_copy[3 * (h / 3) + (h % 3 + 1) % 3];
+      const double len = (x.segment<2>(2 * b) - x.segment<2>(2 * a)).norm();
+      if (len > 0) err = std::max(err, std::abs(x[2 * b + label[i]] - x[2 * a + label[i]]) / len);
+    }
+    return err;
+  };
+  double soft_unit = 0;
+  if (soft_features && fs.size() > 0 && out.status.is_ok()) {
+    const auto to = Clock::now();
+    std::vector<int> proposed(fs.size(), kUnlabeled);
+    std::vector<char> is_new(fs.size(), 1);
+    std::vector<int> uncertain_features;
+    double edge_sq = 0;
+    for (int i = 0; i < fs.size(); ++i) {
+      const double m = feature_measure(cut, x, fs.halfedge[i]);
+      proposed[i] = nearest_label(m);
+      if (options.local_estimation && std::abs(m - std::round(m)) >= options.local_estimation_min_error)
+        uncertain_features.push_back(i);
+    }
+    std::vector<FeatureChoice> fchoices(uncertain_features.size());
+    auto work = [&](size_t u) {
+      fchoices[u] = estimator.choose_feature(uncertain_features[u], matching, label, x, density, power);
+    };
+#ifdef QUADIFY_WITH_TBB
+    tbb::parallel_for(size_t(0), uncertain_features.size(), work);
+#else
+    for (size_t u = 0; u < uncertain_features.size(); ++u) work(u);
+#endif
+    for (size_t u = 0; u < uncertain_features.size(); ++u) {
+      const FeatureChoice& fc = fchoices[u];
+      ++out.stats.n_feature_patches;
+      proposed[uncertain_features[u]] = fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
+    }
+    for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
+                                       options.feature_max_wedge_stretch, options.feature_max_tau))
+      proposed[i] = kDisabled;
+    label = proposed;
+    for (int i = 0; i < fs.size(); ++i) {
+      if (label[i] != 0 && label[i] != 1) continue;
+      const int h = fs.halfedge[i];
+      soft_rows.push_back(feature_row(cut, h, label[i]));
+      edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3))).squaredNorm();
+    }
+    soft_unit = edge_sq > 0 ? total_area / edge_sq : 0;
+    for (double w = 1; !soft_rows.empty() && w <= kMaxSoftFeatureWeight; w *= 10) {
+      soft_weight = w * soft_unit;
+      update_direction_rows();
+      LayoutProblem problem(domain, red, dir_penalty);
+      Eigen::VectorXd y = red.restrict(x);
+      OptimizeSettings st;
+      st.density = density == Density::kPowerSD ? Density::kSymmetricDirichlet : density;
+      st.power = power;
+      st.max_iterations = options.max_newton_iters;
+      st.relative_tolerance = kFinalTolerance;
+      st.penalty_weight = 1;
+      const OptimizeReport rep = optimize_layout(problem, st, &y);
+      out.stats.total_iterations += rep.iterations;
+      out.stats.n_batch_iterations += rep.iterations;
+      add_timers(rep.timers, &out.stats);
+      if (!rep.status.is_ok()) break;
+      x = red.expand(y);
+      if (soft_error() <= options.soft_feature_tolerance) break;
+    }
+    red_problem.reset();
+    out.stats.seconds_optimize += seconds_since(to);
+  }
   if (options.energy == Energy::kTau) {
     const auto to = Clock::now();
-    if (directions.size() > 0) {
+    if (dir_penalty) {
       update_direction_rows();
       red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
     }
@@ -480,7 +570,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       // d(SD/4)^p = (p/4)·(SD/4)^(p−1)·dSD: scale the alignment by the area-weighted mean of that
       // factor in the current layout, so that it keeps its balance with the distortion of the
       // typical face (the continuation otherwise raises the price of distortion p-fold and more).
-      if (directions.size() > 0) {
+      if (dir_penalty) {
         const Eigen::VectorXd sd =
             face_densities(domain, x, Density::kSymmetricDirichlet, 1);
         double factor = 0, area = 0;
@@ -489,13 +579,43 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
             factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
             area += domain.area[f];
           }
-        st.penalty_weight = options.direction_weight * p / 4 * (area > 0 ? factor / area : 1);
+        st.penalty_weight = p / 4 * (area > 0 ? factor / area : 1);
       }
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
       add_timers(rep.timers, &out.stats);
       if (rep.status.is_ok() && std::isfinite(rep.energy)) x = red.expand(y);
+    }
+    // The continuation may let soft features drift past the tolerance: raise their weight at
+    // the last exponent until they are back within it.
+    for (int k = 0; k < kSoftTightenStages && !soft_rows.empty() &&
+                    soft_error() > options.soft_feature_tolerance;
+         ++k) {
+      soft_weight *= 10;
+      update_direction_rows();
+      red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
+      const double p = std::end(kTauPowers)[-1];
+      const Eigen::VectorXd sd = face_densities(domain, x, Density::kSymmetricDirichlet, 1);
+      double factor = 0, area = 0;
+      for (int f = 0; f < domain.n_faces(); ++f)
+        if (std::isfinite(sd[f])) {
+          factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
+          area += domain.area[f];
+        }
+      Eigen::VectorXd y = red.restrict(x);
+      OptimizeSettings st;
+      st.density = Density::kPowerSD;
+      st.power = p;
+      st.max_iterations = options.max_newton_iters;
+      st.relative_tolerance = kFinalTolerance;
+      st.penalty_weight = p / 4 * (area > 0 ? factor / area : 1);
+      const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
+      out.stats.total_iterations += rep.iterations;
+      out.stats.n_tau_iterations += rep.iterations;
+      add_timers(rep.timers, &out.stats);
+      if (!rep.status.is_ok() || !std::isfinite(rep.energy)) break;
+      x = red.expand(y);
     }
     out.stats.seconds_tau += seconds_since(to);
     out.stats.seconds_optimize += seconds_since(to);

@@ -280,6 +280,34 @@ TEST(FeatureAlignment, BoxEdgesAreAlignedAndCornersAreCones) {
   for (const ConeInfo& k : r.cones) EXPECT_EQ(k.index, 1);
 }
 
+// Alg. 3: the same box with the features labeled after the matchings and pulled in by a
+// penalty: aligned within the tolerance (not exactly), every box edge kept, flip-free; the box's
+// sides still become rectangles, so the corners are the eight +1 cones and τ stays near 1.
+TEST(FeatureAlignment, SoftFeaturesAfterRoundingAreAlignedWithinTolerance) {
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("box.obj")));
+  ParamOptions o = fast_options();
+  o.feature_edges = sharp_edge_pairs(mesh, 40);
+  o.feature_mode = FeatureMode::kAfterRounding;
+  const ParamResult r = compute_seamless_param(mesh, o);
+  const Checked c = check_result("box soft", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8);
+  EXPECT_EQ(r.stats.n_aligned_features, 72);
+  const double measured = feature_misalignment(mesh, r);
+  EXPECT_LE(measured, o.soft_feature_tolerance);
+  EXPECT_NEAR(r.stats.feature_alignment_error, measured, 1e-12);
+  EXPECT_LT(r.stats.tau, 1.05);
+  // Twelve arbitrary edges of a torus as features: those labeled are aligned softly, flip-free.
+  const core::TriMesh torus = core::to_trimesh(core::read_mesh(test::data_path("torus.obj")));
+  ParamOptions ot = fast_options();
+  ot.feature_mode = FeatureMode::kAfterRounding;
+  ot.feature_edges = sharp_edge_pairs(torus, 1e-3);
+  ot.feature_edges.resize(std::min<size_t>(ot.feature_edges.size(), 12));
+  const ParamResult rt = compute_seamless_param(torus, ot);
+  check_result("torus soft", torus, rt);
+  EXPECT_LE(feature_misalignment(torus, rt), ot.soft_feature_tolerance);
+  EXPECT_GT(rt.stats.n_aligned_features, 0);
+}
+
 TEST(FeatureAlignment, DiskBoundaryIsAligned) {
   const core::TriMesh mesh = test::make_disk(8, 24);
   ParamOptions o = fast_options();

@@ -221,6 +221,29 @@ TEST_F(CliTest, ParamWritesSeamlessFlipFreeUvObj) {
   EXPECT_LT(j["tau"].get<double>(), 3.0);
 }
 
+// --feature-mode after (Alg. 3): the cube's edges are aligned softly, within 1e-5, and the
+// written map is still seamless and flip-free; a mode that does not exist is bad input.
+TEST_F(CliTest, SoftFeatureModeAlignsWithinTolerance) {
+  write_text(dir_ / "cube.obj", kCubeTriObj);
+  std::string args;
+  args.append("param '").append((dir_ / "cube.obj").string()).append("' -o '");
+  args.append((dir_ / "c_uv.obj").string()).append("' --json '").append((dir_ / "p.json").string());
+  const CliRun r = quadify(args + "' --feature-mode after", dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto f = nlohmann::json::parse(slurp(dir_ / "p.json"))["param"]["features"];
+  EXPECT_EQ(f["mode"], "after");
+  EXPECT_EQ(f["aligned"], 12);
+  EXPECT_LE(f["alignment_error"].get<double>(), 1e-5);
+  const CliRun c = quadify("check '" + (dir_ / "c_uv.obj").string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["flipped"], 0);
+  EXPECT_EQ(j["cone_index_sum"], 8);
+  EXPECT_LT(j["seam_residual_abs"].get<double>(), 1e-9);
+  const CliRun bad = quadify(args + "' --feature-mode sometimes", dir_);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+}
+
 // The default command end to end, measured by `check --reference` on the written file.
 TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   const fs::path out = dir_ / "spot_quads.obj";

@@ -107,6 +107,13 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
   app.add_flag("!--no-boundary-alignment", a->boundaries,
                "Do not align boundaries with quad edges (by default they are features, so open meshes "
                "get quads along their boundaries)");
+  app.add_option("--feature-mode", a->soft,
+                 "When features are aligned: 'during' the rounding of the matchings, as hard "
+                 "constraints (paper Alg. 2), or 'after' it, as soft constraints pulled in until "
+                 "the alignment error is at most 1e-5 (Alg. 3: the map keeps its distortion bound, "
+                 "fewer features are disabled)")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"during", false}, {"after", true}}))
+      ->default_str("during");
   app.add_option("--feature-max-tau", a->max_tau,
                  "Disable a feature whose locally estimated distortion tau stays above this")
       ->capture_default_str()
@@ -127,6 +134,8 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   const core::EdgeTopology topo = core::build_edge_topology(mesh);
   options->align_boundaries = args.boundaries;
   options->feature_max_tau = args.max_tau;
+  options->feature_mode = args.soft ? param::FeatureMode::kAfterRounding : param::FeatureMode::kDuringRounding;
+  fi.soft = args.soft;
   options->feature_max_wedge_stretch = args.max_wedge_stretch;
   options->feature_edges.clear();
   if (args.angle_deg > 0) {
@@ -217,7 +226,8 @@ void warn_feature_fallbacks(const std::string& input, const param::ParamStats& s
 }
 
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
-  return {{"detected_sharp_edges", fi.n_detected},
+  return {{"mode", fi.soft ? "after" : "during"},
+          {"detected_sharp_edges", fi.n_detected},
           {"sharp_edges_not_creases", fi.n_not_creases},
           {"given_edges", fi.n_given},
           {"given_edges_lost_in_repair", fi.n_lost},

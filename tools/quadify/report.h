@@ -91,6 +91,7 @@ struct FeatureArgs {
   bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
   double max_tau = 2.5;      // --feature-max-tau
   double max_wedge_stretch = 1.8;  // --feature-max-wedge-stretch
+  bool soft = false;         // --feature-mode after: Alg. 3 (param::FeatureMode::kAfterRounding)
 };
 void add_feature_options(CLI::App& app, FeatureArgs* args);
 // One line on stderr (unless quiet) when components of `input` fell back to a parametrization
@@ -105,6 +106,7 @@ struct FeatureInput {
   int n_given = 0;     // edges from the file and the OBJ lines
   int n_lost = 0;      // given edges that the repair removed (e.g. with a degenerate face)
   int n_too_small = 0;  // edges of curves too short for the quad density (remesh only)
+  bool soft = false;    // Alg. 3 (--feature-mode after)
 };
 FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
                                 const LoadedMesh& loaded, param::ParamOptions* options);

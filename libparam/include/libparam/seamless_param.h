@@ -26,6 +26,13 @@ enum class Energy {
   kConformal,          // MIPS conformal energy Σ area·(σ1/σ2 + σ2/σ1); scale-free
 };
 
+// When feature edges get their alignment (paper section 6).
+enum class FeatureMode {
+  kDuringRounding,  // Alg. 2: labeled with the matchings, batch by batch, as hard constraints
+  kAfterRounding,   // Alg. 3: after every matching is rounded, as soft constraints (a penalty
+                    // raised until the alignment error is at most soft_feature_tolerance)
+};
+
 // Order of the batches of matching rounding (paper 8.1).
 enum class RoundingOrder {
   kBottomUp,  // ε = step, 2·step, …, 0.5: round the most certain matchings first (default)
@@ -79,6 +86,10 @@ struct ParamOptions {
   // against 2.5: flipped quads fandisk 16 → 1, beetle 20 → 14, wingnut 1 → 0, for feature capture
   // fandisk 0.982 → 0.950 and beetle 0.980 → 0.932 (wingnut 0.807 → 0.846).
   double feature_max_wedge_stretch = 1.8;
+  FeatureMode feature_mode = FeatureMode::kDuringRounding;
+  // Alg. 3: largest |Δ constant coordinate| / |edge| accepted for a soft-aligned feature (the
+  // paper reports at most 1e-5).
+  double soft_feature_tolerance = 1e-5;
   // Isotropic sizing (paper section 7): the target edge length of each face relative to its 3D
   // size (#F positive values; empty = uniform). The distortion energy compares the map with the
   // triangle scaled by 1/face_size (the "transformed source triangle"), so a face of size 2 asks
