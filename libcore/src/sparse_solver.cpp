@@ -3,6 +3,11 @@
 #include <Eigen/SparseCholesky>
 #ifdef QUADIFY_WITH_CHOLMOD
 #include <Eigen/CholmodSupport>
+
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <mutex>
 #endif
 
 namespace quadify::core {
@@ -14,6 +19,29 @@ namespace {
 // CHOLMOD's OpenMP threads inside every TBB task. Measured on elk's parametrization (354 patches,
 // 2 cores): see the README design note on the sparse solver.
 constexpr Eigen::Index kSimplicialMaxSize = 4000;
+
+#ifdef QUADIFY_WITH_CHOLMOD
+// CHOLMOD of SuiteSparse 5 opens an OpenMP team of CHOLMOD_OMP_NUM_THREADS (compiled in: 4) for
+// the scatter of every large supernode, and OpenBLAS runs its own threads for the dense blocks.
+// On our 2-core machines, next to TBB's workers, those teams oversubscribe the cores: their
+// threads spin and yield (a remesh of spot made 1.1 million futex and 0.2 million sched_yield
+// calls), and under load a factorization took 4× longer (fandisk with soft features, load 6:
+// 30.8 s of factorization against 7.1 s single-threaded). So both run single-threaded; the
+// parallelism is TBB's (components, patches, per-face work). The symbols are looked up at run
+// time: nothing changes with another BLAS or a CHOLMOD without OpenMP, or when the user sets
+// OMP_NUM_THREADS, OMP_THREAD_LIMIT or OPENBLAS_NUM_THREADS.
+void limit_library_threads() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (!std::getenv("OMP_NUM_THREADS") && !std::getenv("OMP_THREAD_LIMIT"))
+      if (auto* set_levels = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels")))
+        set_levels(0);  // every parallel region runs on the calling thread alone
+    if (!std::getenv("OPENBLAS_NUM_THREADS"))
+      if (auto* set_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
+        set_threads(1);
+  });
+}
+#endif
 }  // namespace
 
 struct SparseSolver::Impl {
@@ -36,6 +64,7 @@ struct SparseSolver::Impl {
 
 SparseSolver::SparseSolver() : impl_(std::make_unique<Impl>()) {
 #ifdef QUADIFY_WITH_CHOLMOD
+  limit_library_threads();
   impl_->supernodal.cholmod().print = 0;  // failures come back as Status; a library never prints
 #endif
 }
