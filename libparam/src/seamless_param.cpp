@@ -82,6 +82,16 @@ constexpr int kMaxCancellationFailures = 6;
 // Passes of the cone-pair cancellation: a cone of |index| > 1 loses one unit per pass.
 constexpr int kConePairPasses = 4;
 
+// work(i) for i in [0, n): in parallel with TBB (independent items), else in order.
+template <class F>
+void for_each_index(size_t n, F&& work) {
+#ifdef QUADIFY_WITH_TBB
+  tbb::parallel_for(size_t(0), n, work);
+#else
+  for (size_t i = 0; i < n; ++i) work(i);
+#endif
+}
+
 double batch_threshold(const ParamOptions& o, int i) {
   return o.order == RoundingOrder::kBottomUp ? o.threshold_step * (i + 1)
                                              : 0.5 - o.threshold_step * (i + 1);
@@ -162,29 +172,61 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
 
   const auto [density, power] = energy_density(options.energy);
 
+  // One minimisation of the batch energy plus the penalty rows (rebuilt from x first) over red;
+  // false when it failed (x unchanged).
+  auto solve_with_penalty = [&] {
+    update_direction_rows();
+    LayoutProblem problem(domain, red, dir_penalty);
+    Eigen::VectorXd y = red.restrict(x);
+    OptimizeSettings st;
+    st.density = density;
+    st.power = power;
+    st.max_iterations = options.max_newton_iters;
+    st.relative_tolerance = kBatchTolerance;
+    st.penalty_weight = 1;
+    const OptimizeReport rep = optimize_layout(problem, st, &y);
+    out.stats.total_iterations += rep.iterations;
+    out.stats.n_batch_iterations += rep.iterations;
+    add_timers(rep.timers, &out.stats);
+    if (rep.status.is_ok()) x = red.expand(y);
+    return rep.status.is_ok();
+  };
+  // The penalty's weight in the L^p stage of exponent p: d(SD/4)^p = (p/4)·(SD/4)^(p−1)·dSD, so
+  // scaled by the area-weighted mean of that factor in the current layout, the penalty keeps its
+  // balance with the distortion of the typical face (the continuation otherwise raises the price
+  // of distortion p-fold and more).
+  auto power_penalty_weight = [&](double p) {
+    const Eigen::VectorXd sd = face_densities(domain, x, Density::kSymmetricDirichlet, 1);
+    double factor = 0, area = 0;
+    for (int f = 0; f < domain.n_faces(); ++f)
+      if (std::isfinite(sd[f])) {
+        factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
+        area += domain.area[f];
+      }
+    return p / 4 * (area > 0 ? factor / area : 1);
+  };
   // With directions, the unconstrained layout first bends towards them, so that the matchings are
   // measured on an aligned layout (the layout plays the part of a cross field).
-  if (directions.size() > 0) {
-    for (int pass = 0; pass < 2; ++pass) {
-      update_direction_rows();
-      LayoutProblem problem(domain, red, dir_penalty);
-      Eigen::VectorXd y = red.restrict(x);
-      OptimizeSettings st;
-      st.density = density;
-      st.power = power;
-      st.max_iterations = options.max_newton_iters;
-      st.relative_tolerance = kBatchTolerance;
-      st.penalty_weight = 1;
-      const OptimizeReport rep = optimize_layout(problem, st, &y);
-      out.stats.total_iterations += rep.iterations;
-      out.stats.n_batch_iterations += rep.iterations;
-      add_timers(rep.timers, &out.stats);
-      if (rep.status.is_ok()) x = red.expand(y);
-    }
-  }
+  for (int pass = 0; pass < 2 && directions.size() > 0; ++pass) solve_with_penalty();
 
   const bool soft_features = options.feature_mode == FeatureMode::kAfterRounding;
   const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
+  // Labels of uncertain features by local estimation (patches independent: parallel,
+  // deterministic); a label whose better patch still exceeds feature_max_tau is disabled.
+  auto estimate_feature_labels = [&](const std::vector<int>& uncertain, std::vector<int>* proposed) {
+    const auto tl = Clock::now();
+    std::vector<FeatureChoice> choices(uncertain.size());
+    auto work = [&](size_t u) {
+      choices[u] = estimator.choose_feature(uncertain[u], matching, label, x, density, power);
+    };
+    for_each_index(uncertain.size(), work);
+    for (size_t u = 0; u < uncertain.size(); ++u) {
+      const FeatureChoice& fc = choices[u];
+      ++out.stats.n_feature_patches;
+      (*proposed)[uncertain[u]] = fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
+    }
+    out.stats.seconds_local_estimation += seconds_since(tl);
+  };
   const int n_steps =
       static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
   for (int step = 0; step < n_steps; ++step) {
@@ -230,11 +272,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         const int s = batch[uncertain[u]];
         choices[u] = estimator.choose(s, m[s], matching, label, x, density, power);
       };
-#ifdef QUADIFY_WITH_TBB
-      tbb::parallel_for(size_t(0), uncertain.size(), work);
-#else
-      for (size_t u = 0; u < uncertain.size(); ++u) work(u);
-#endif
+      for_each_index(uncertain.size(), work);
       for (size_t u = 0; u < uncertain.size(); ++u) {
         ++out.stats.n_patches;
         if (choices[u].matching != chosen[uncertain[u]]) ++out.stats.n_improved;
@@ -256,24 +294,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
           uncertain_features.push_back(i);
       }
       if (!uncertain_features.empty()) {
-        const auto tl = Clock::now();
-        std::vector<FeatureChoice> fchoices(uncertain_features.size());
-        auto work = [&](size_t u) {
-          fchoices[u] =
-              estimator.choose_feature(uncertain_features[u], matching, label, x, density, power);
-        };
-#ifdef QUADIFY_WITH_TBB
-        tbb::parallel_for(size_t(0), uncertain_features.size(), work);
-#else
-        for (size_t u = 0; u < uncertain_features.size(); ++u) work(u);
-#endif
-        for (size_t u = 0; u < uncertain_features.size(); ++u) {
-          const FeatureChoice& fc = fchoices[u];
-          ++out.stats.n_feature_patches;
-          proposed[uncertain_features[u]] =
-              fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
-        }
-        out.stats.seconds_local_estimation += seconds_since(tl);
+        estimate_feature_labels(uncertain_features, &proposed);
       }
       for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
                                          options.feature_max_wedge_stretch, options.feature_max_tau))
@@ -505,20 +526,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       if (options.local_estimation && std::abs(m - std::round(m)) >= options.local_estimation_min_error)
         uncertain_features.push_back(i);
     }
-    std::vector<FeatureChoice> fchoices(uncertain_features.size());
-    auto work = [&](size_t u) {
-      fchoices[u] = estimator.choose_feature(uncertain_features[u], matching, label, x, density, power);
-    };
-#ifdef QUADIFY_WITH_TBB
-    tbb::parallel_for(size_t(0), uncertain_features.size(), work);
-#else
-    for (size_t u = 0; u < uncertain_features.size(); ++u) work(u);
-#endif
-    for (size_t u = 0; u < uncertain_features.size(); ++u) {
-      const FeatureChoice& fc = fchoices[u];
-      ++out.stats.n_feature_patches;
-      proposed[uncertain_features[u]] = fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
-    }
+    estimate_feature_labels(uncertain_features, &proposed);
     for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
                                        options.feature_max_wedge_stretch, options.feature_max_tau))
       proposed[i] = kDisabled;
@@ -530,25 +538,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3))).squaredNorm();
     }
     soft_unit = edge_sq > 0 ? total_area / edge_sq : 0;
+    // Each stage only has to bring the features closer; the error is measured after it.
     for (double w = 1; !soft_rows.empty() && w <= kMaxSoftFeatureWeight; w *= 10) {
       soft_weight = w * soft_unit;
-      update_direction_rows();
-      LayoutProblem problem(domain, red, dir_penalty);
-      Eigen::VectorXd y = red.restrict(x);
-      OptimizeSettings st;
-      st.density = density == Density::kPowerSD ? Density::kSymmetricDirichlet : density;
-      st.power = power;
-      st.max_iterations = options.max_newton_iters;
-      // Each stage only has to bring the features closer; the error is measured after it.
-      st.relative_tolerance = kBatchTolerance;
-      st.penalty_weight = 1;
-      const OptimizeReport rep = optimize_layout(problem, st, &y);
-      out.stats.total_iterations += rep.iterations;
-      out.stats.n_batch_iterations += rep.iterations;
-      add_timers(rep.timers, &out.stats);
-      if (!rep.status.is_ok()) break;
-      x = red.expand(y);
-      if (soft_error() <= options.soft_feature_tolerance) break;
+      if (!solve_with_penalty() || soft_error() <= options.soft_feature_tolerance) break;
     }
     red_problem.reset();
     out.stats.seconds_optimize += seconds_since(to);
@@ -568,20 +561,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.power = p;
       st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
       st.relative_tolerance = p == std::end(kTauPowers)[-1] ? kFinalTolerance : kTauStageTolerance;
-      // d(SD/4)^p = (p/4)·(SD/4)^(p−1)·dSD: scale the alignment by the area-weighted mean of that
-      // factor in the current layout, so that it keeps its balance with the distortion of the
-      // typical face (the continuation otherwise raises the price of distortion p-fold and more).
-      if (dir_penalty) {
-        const Eigen::VectorXd sd =
-            face_densities(domain, x, Density::kSymmetricDirichlet, 1);
-        double factor = 0, area = 0;
-        for (int f = 0; f < domain.n_faces(); ++f)
-          if (std::isfinite(sd[f])) {
-            factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
-            area += domain.area[f];
-          }
-        st.penalty_weight = p / 4 * (area > 0 ? factor / area : 1);
-      }
+      if (dir_penalty) st.penalty_weight = power_penalty_weight(p);
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
@@ -597,20 +577,13 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       update_direction_rows();
       red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
       const double p = std::end(kTauPowers)[-1];
-      const Eigen::VectorXd sd = face_densities(domain, x, Density::kSymmetricDirichlet, 1);
-      double factor = 0, area = 0;
-      for (int f = 0; f < domain.n_faces(); ++f)
-        if (std::isfinite(sd[f])) {
-          factor += domain.area[f] * std::pow(sd[f] / 4, p - 1);
-          area += domain.area[f];
-        }
       Eigen::VectorXd y = red.restrict(x);
       OptimizeSettings st;
       st.density = Density::kPowerSD;
       st.power = p;
       st.max_iterations = options.max_newton_iters;
       st.relative_tolerance = kFinalTolerance;
-      st.penalty_weight = p / 4 * (area > 0 ? factor / area : 1);
+      st.penalty_weight = power_penalty_weight(p);
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
