@@ -58,6 +58,10 @@ constexpr double kTauStageTolerance = 1e-5;
 // extra ×10 stages after the L^p continuation.
 constexpr double kMaxSoftFeatureWeight = 1e9;
 constexpr int kSoftTightenStages = 4;
+// Alg. 3: rounds of pulling the features in, disabling those next to over-stretched faces after
+// each but the last.
+constexpr int kSoftFeatureRounds = 2;
+constexpr double kSoftStretchGrowth = 1.25;
 
 struct ComponentOutput {
   core::Status status;
@@ -519,7 +523,6 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     std::vector<int> proposed(fs.size(), kUnlabeled);
     std::vector<char> is_new(fs.size(), 1);
     std::vector<int> uncertain_features;
-    double edge_sq = 0;
     for (int i = 0; i < fs.size(); ++i) {
       const double m = feature_measure(cut, x, fs.halfedge[i]);
       proposed[i] = nearest_label(m);
@@ -531,17 +534,51 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                                        options.feature_max_wedge_stretch, options.feature_max_tau))
       proposed[i] = kDisabled;
     label = proposed;
-    for (int i = 0; i < fs.size(); ++i) {
-      if (label[i] != 0 && label[i] != 1) continue;
-      const int h = fs.halfedge[i];
-      soft_rows.push_back(feature_row(cut, h, label[i]));
-      edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3))).squaredNorm();
-    }
-    soft_unit = edge_sq > 0 ? total_area / edge_sq : 0;
-    // Each stage only has to bring the features closer; the error is measured after it.
-    for (double w = 1; !soft_rows.empty() && w <= kMaxSoftFeatureWeight; w *= 10) {
-      soft_weight = w * soft_unit;
-      if (!solve_with_penalty() || soft_error() <= options.soft_feature_tolerance) break;
+    // Features next to a face stretched beyond feature_max_tau by the pull (max(σ1, 1/σ2): labels
+    // that the fixed matchings cannot honour without crushing triangles) are disabled, and the
+    // stages are redone from the unaligned layout.
+    const Eigen::VectorXd x_unaligned = x;
+    for (int round = 0; round < kSoftFeatureRounds; ++round) {
+      soft_rows.clear();
+      double edge_sq = 0;
+      for (int i = 0; i < fs.size(); ++i) {
+        if (label[i] != 0 && label[i] != 1) continue;
+        const int h = fs.halfedge[i];
+        soft_rows.push_back(feature_row(cut, h, label[i]));
+        edge_sq += (mesh.V.row(mesh.F(h / 3, h % 3)) - mesh.V.row(mesh.F(h / 3, (h % 3 + 1) % 3))).squaredNorm();
+      }
+      soft_unit = edge_sq > 0 ? total_area / edge_sq : 0;
+      // Each stage only has to bring the features closer; the error is measured after it.
+      for (double w = 1; !soft_rows.empty() && w <= kMaxSoftFeatureWeight; w *= 10) {
+        soft_weight = w * soft_unit;
+        if (!solve_with_penalty() || soft_error() <= options.soft_feature_tolerance) break;
+      }
+      if (round + 1 == kSoftFeatureRounds) break;
+      auto stretch = [&](int f, const Eigen::VectorXd& xv) {
+        const Eigen::Matrix2d J = face_jacobian(domain, f, xv);
+        const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+        const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+        const double s1 = 0.5 * (ps + pa), s2 = 0.5 * (ps - pa);
+        return s2 > 0 ? std::max(s1, 1 / s2) : std::numeric_limits<double>::infinity();
+      };
+      // Stretched by the features: beyond the bound, and clearly more than without them (faces
+      // near cones may exceed the bound anyway).
+      std::vector<char> stretched(mesh.n_faces(), 0);
+      for (int f = 0; f < mesh.n_faces(); ++f) {
+        const double sf = stretch(f, x);
+        stretched[f] = sf > options.feature_max_tau && sf > kSoftStretchGrowth * stretch(f, x_unaligned);
+      }
+      int n_disabled = 0;
+      for (int i = 0; i < fs.size(); ++i) {
+        if (label[i] != 0 && label[i] != 1) continue;
+        const int h = fs.halfedge[i], t = cut.topo.twin[h];
+        if (stretched[h / 3] || (t >= 0 && stretched[t / 3])) {
+          label[i] = kDisabled;
+          ++n_disabled;
+        }
+      }
+      if (n_disabled == 0) break;
+      x = x_unaligned;
     }
     red_problem.reset();
     out.stats.seconds_optimize += seconds_since(to);
