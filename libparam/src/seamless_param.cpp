@@ -135,21 +135,21 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   out.stats.n_direction_faces = directions.size();
   // Penalty rows of the layout energy, weights folded in: the directions' (×√direction_weight,
   // re-labeled from the current layout) and, with Alg. 3, the soft features' (×√soft_weight).
-  std::vector<SparseRow> dir_rows;
-  const std::vector<SparseRow>* dir_penalty = nullptr;
+  std::vector<SparseRow> penalty_row_store;
+  const std::vector<SparseRow>* penalty_rows = nullptr;
   std::vector<SparseRow> soft_rows;  // unit-weight rows of the soft-aligned features
   double soft_weight = 0;
-  auto update_direction_rows = [&] {
+  auto update_penalty_rows = [&] {
     if (directions.size() == 0 && soft_rows.empty()) return;
-    dir_rows = directions.size() > 0 ? direction_rows(domain, directions, x) : std::vector<SparseRow>{};
+    penalty_row_store = directions.size() > 0 ? direction_rows(domain, directions, x) : std::vector<SparseRow>{};
     const double sd = std::sqrt(options.direction_weight), sf = std::sqrt(soft_weight);
-    for (SparseRow& row : dir_rows)
+    for (SparseRow& row : penalty_row_store)
       for (auto& entry : row.entries) entry.second *= sd;
     for (const SparseRow& row : soft_rows) {
-      dir_rows.push_back(row);
-      for (auto& entry : dir_rows.back().entries) entry.second *= sf;
+      penalty_row_store.push_back(row);
+      for (auto& entry : penalty_row_store.back().entries) entry.second *= sf;
     }
-    dir_penalty = &dir_rows;
+    penalty_rows = &penalty_row_store;
   };
   if ((fs.size() > 0 && options.feature_global_rotation) || directions.size() > 0) {
     const double angle = fs.size() > 0 && options.feature_global_rotation
@@ -179,8 +179,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   // One minimisation of the batch energy plus the penalty rows (rebuilt from x first) over red;
   // false when it failed (x unchanged).
   auto solve_with_penalty = [&] {
-    update_direction_rows();
-    LayoutProblem problem(domain, red, dir_penalty);
+    update_penalty_rows();
+    LayoutProblem problem(domain, red, penalty_rows);
     Eigen::VectorXd y = red.restrict(x);
     OptimizeSettings st;
     st.density = density;
@@ -396,8 +396,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
     red_problem.reset();
     red = std::move(tr.reduction);
-    update_direction_rows();
-    red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
+    update_penalty_rows();
+    red_problem = std::make_unique<LayoutProblem>(domain, red, penalty_rows);
     if (!tr.status.is_ok()) {
       out.status = tr.status;
     }
@@ -473,8 +473,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         st.power = power;
         st.max_iterations = options.max_newton_iters;
         st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
-        update_direction_rows();
-        st.penalty_rows = dir_penalty;
+        update_penalty_rows();
+        st.penalty_rows = penalty_rows;
         st.penalty_weight = 1;
         const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
         out.stats.total_iterations += rep.iterations;
@@ -585,9 +585,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   if (options.energy == Energy::kTau) {
     const auto to = Clock::now();
-    if (dir_penalty) {
-      update_direction_rows();
-      red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
+    if (penalty_rows) {
+      update_penalty_rows();
+      red_problem = std::make_unique<LayoutProblem>(domain, red, penalty_rows);
     }
     if (!red_problem) red_problem = std::make_unique<LayoutProblem>(domain, red);
     for (double p : kTauPowers) {
@@ -598,7 +598,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       st.power = p;
       st.max_iterations = std::min(options.max_newton_iters, kTauStageIterations);
       st.relative_tolerance = p == std::end(kTauPowers)[-1] ? kFinalTolerance : kTauStageTolerance;
-      if (dir_penalty) st.penalty_weight = power_penalty_weight(p);
+      if (penalty_rows) st.penalty_weight = power_penalty_weight(p);
       const OptimizeReport rep = optimize_layout(*red_problem, st, &y);
       out.stats.total_iterations += rep.iterations;
       out.stats.n_tau_iterations += rep.iterations;
@@ -611,8 +611,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
                     soft_error() > options.soft_feature_tolerance;
          ++k) {
       soft_weight *= 10;
-      update_direction_rows();
-      red_problem = std::make_unique<LayoutProblem>(domain, red, dir_penalty);
+      update_penalty_rows();
+      red_problem = std::make_unique<LayoutProblem>(domain, red, penalty_rows);
       const double p = std::end(kTauPowers)[-1];
       Eigen::VectorXd y = red.restrict(x);
       OptimizeSettings st;
