@@ -41,9 +41,6 @@ constexpr double kIntoQuadSteps[] = {0.3, 0.1};
 // A move is kept when it raises the local worst scaled Jacobian by more than this (round-off).
 constexpr double kMinImprovement = 1e-9;
 
-// Worst corner scaled Jacobian of quad f (see RelaxOptions).
-double quad_sj(const core::PolyMesh& q, int f) { return quad_corners(q, f).min_scaled_jacobian(); }
-
 }  // namespace
 
 RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& surface,
@@ -120,10 +117,30 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
 
   core::PolyMesh& q = res.quads;
+  // Quality of quad f: its worst corner scaled Jacobian (see RelaxOptions); a quad facing away
+  // from the surface (area vector against the normal of the surface triangle closest to its
+  // centroid, as `quadify check` counts flips) scores the cosine between the two instead when
+  // that is lower, so that a sliver folded onto the wrong side of a crease counts as flipped and
+  // moves that turn it around count as improvements.
+  auto quad_quality = [&](int f) {
+    const QuadCorners corners = quad_corners(q, f);
+    double quality = corners.min_scaled_jacobian();
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 4; ++k) centroid += corners.p[k] / 4.0;
+    const Triangle& t = *tree.closest_point_and_primitive(Point(centroid.x(), centroid.y(), centroid.z())).second;
+    const Kernel::Vector_3 n = CGAL::cross_product(t[1] - t[0], t[2] - t[0]);
+    const Eigen::Vector3d normal(n.x(), n.y(), n.z());
+    const double denom = normal.norm() * corners.area_vector.norm();
+    if (denom > 0) {
+      const double cosine = normal.dot(corners.area_vector) / denom;
+      if (cosine < 0) quality = std::min(quality, cosine);
+    }
+    return quality;
+  };
   auto count_bad = [&](double threshold) {
     int n = 0;
     for (int f = 0; f < nf; ++f)
-      if (q.degree(f) == 4 && quad_sj(q, f) < threshold) ++n;
+      if (q.degree(f) == 4 && quad_quality(f) < threshold) ++n;
     return n;
   };
   const double kFlipped = std::numeric_limits<double>::min();
@@ -131,7 +148,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   res.stats.n_flipped_before = count_bad(kFlipped);
   auto local_worst = [&](int v) {
     double w = std::numeric_limits<double>::infinity();
-    for (int f : vertex_quads[v]) w = std::min(w, quad_sj(q, f));
+    for (int f : vertex_quads[v]) w = std::min(w, quad_quality(f));
     return w;
   };
   // Rounds over the vertices of the quads below `threshold` (and `rings` rings around them);
@@ -144,7 +161,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       std::vector<char> in_set(nv, 0);
       std::vector<int> set;
       for (int f = 0; f < nf; ++f)
-        if (q.degree(f) == 4 && quad_sj(q, f) < threshold)
+        if (q.degree(f) == 4 && quad_quality(f) < threshold)
           for (int k = 0; k < 4; ++k)
             if (!in_set[q.vertex(f, k)]) {
               in_set[q.vertex(f, k)] = 1;
@@ -172,7 +189,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         std::vector<Eigen::Vector3d> targets;
         for (const double step : {1.0, kHalfStep}) targets.push_back(old + step * (centroid - old));
         for (int f : vertex_quads[v]) {
-          if (quad_sj(q, f) >= threshold) continue;
+          if (quad_quality(f) >= threshold) continue;
           Eigen::Vector3d c = Eigen::Vector3d::Zero();
           for (int k = 0; k < 4; ++k) c += q.V.row(q.vertex(f, k)).transpose();
           for (const double step : kIntoQuadSteps) targets.push_back(old + step * (0.25 * c - old));
@@ -206,7 +223,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   if (options.release_features_for_flips && count_bad(kFlipped) > 0) {
     std::vector<char> released(nv, 0);
     for (int f = 0; f < nf; ++f)
-      if (q.degree(f) == 4 && quad_sj(q, f) < kFlipped)
+      if (q.degree(f) == 4 && quad_quality(f) < kFlipped)
         for (int k = 0; k < 4; ++k) {
           const int v = q.vertex(f, k);
           if ((on_feature[v] || fixed[v]) && !non_manifold[v] && !vertex_quads[v].empty()) released[v] = 1;

@@ -1,5 +1,7 @@
-// relax_bad_quads: repairs reflex corners on a constructed planar grid, keeps vertices on the
-// surface and the boundary fixed, leaves good meshes alone, rejects bad input.
+// relax_bad_quads: repairs reflex corners on a constructed planar grid and quads folded over a
+// crease, keeps vertices on the surface and the boundary fixed, leaves good meshes alone, rejects
+// bad input.
+#include <libquadex/quad_metrics.h>
 #include <libquadex/relax_quads.h>
 
 #include <gtest/gtest.h>
@@ -87,6 +89,53 @@ TEST(RelaxQuads, LastResortMovesAFeatureVertexOffAFlatCorner) {
   EXPECT_GE(r.stats.n_feature_vertices_moved, 1);
   EXPECT_NE(r.quads.V.row(v), q.V.row(v));
   for (int w = 0; w < q.n_vertices(); ++w) EXPECT_NEAR(r.quads.V(w, 2), 0.0, 1e-12);
+}
+
+// Two faces of a box meeting at a convex edge along x: the top (z = 1, normal +z) and the front
+// (y = 0, normal -y), for 0 ≤ x ≤ n.
+core::TriMesh box_edge(int n) {
+  core::TriMesh t;
+  t.V.resize(6, 3);
+  t.V << 0, 0, 1, n, 0, 1, n, 1, 1, 0, 1, 1, 0, 0, 0, n, 0, 0;
+  t.F.resize(4, 3);
+  t.F << 0, 1, 2, 0, 2, 3, 4, 1, 0, 4, 5, 1;
+  return t;
+}
+
+// A point of box_edge at x and arc length s from the back of the top (s ≤ 1 on the top, s ≥ 1
+// down the front).
+Eigen::Vector3d on_box_edge(double x, double s) {
+  return s <= 1 ? Eigen::Vector3d(x, 1 - s, 1) : Eigen::Vector3d(x, 0, 2 - s);
+}
+
+TEST(RelaxQuads, TurnsAroundQuadsFoldedOverACrease) {
+  // Four rows of quad vertices across the edge at s = 0.5, 0.9, 1.1, 1.5 (columns x = 0..n).
+  // Between the boundary columns the two middle rows are swapped: the quads between them are
+  // rectangles with perfect corners that face away from the surface (as a sliver folded over a
+  // crease does after extraction). The repair must see them as flipped and unfold them.
+  const int n = 6;
+  const double rows[] = {0.5, 0.9, 1.1, 1.5};
+  core::PolyMesh q;
+  q.V.resize(4 * (n + 1), 3);
+  for (int r = 0; r < 4; ++r)
+    for (int i = 0; i <= n; ++i) {
+      const bool swapped = (r == 1 || r == 2) && i > 0 && i < n;
+      q.V.row(r * (n + 1) + i) = on_box_edge(i, rows[swapped ? 3 - r : r]).transpose();
+    }
+  for (int r = 0; r < 3; ++r)
+    for (int i = 0; i < n; ++i) {
+      const int a = r * (n + 1) + i;
+      q.add_face({a, a + n + 1, a + n + 2, a + 1});  // along s, then along x: facing outwards
+    }
+  const core::TriMesh surface = box_edge(n);
+  ASSERT_GE(compute_quad_metrics(q, &surface).n_flipped, n - 2);
+  const RelaxResult r = relax_bad_quads(q, surface);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_GE(r.stats.n_flipped_before, n - 2);
+  EXPECT_EQ(r.stats.n_flipped_after, 0);
+  const QuadMetrics m = compute_quad_metrics(r.quads, &surface);
+  EXPECT_EQ(m.n_flipped, 0);
+  EXPECT_GT(m.sj_min, 0.0);
 }
 
 TEST(RelaxQuads, RejectsBadInput) {

@@ -36,7 +36,10 @@ struct RelaxOptions {
 struct RelaxStats {
   int n_bad_before = 0;  // quads below min_scaled_jacobian before
   int n_bad_after = 0;   // and after
-  int n_flipped_before = 0, n_flipped_after = 0;  // quads with a corner scaled Jacobian ≤ 0
+  // Quads with a corner scaled Jacobian ≤ 0 or facing away from the surface (their area vector
+  // against the normal of the surface triangle closest to their centroid, as quad_metrics counts
+  // flips); the repair treats such a quad's cosine to that normal as its quality.
+  int n_flipped_before = 0, n_flipped_after = 0;
   int n_moves = 0;       // accepted vertex moves
   int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
   double seconds = 0;
