@@ -414,6 +414,23 @@ Eigen::Matrix2d face_jacobian(const LayoutDomain& domain, int f, const Eigen::Ve
   return X * domain.rest_inverse[f];
 }
 
+Eigen::Vector2d face_singular_values(const LayoutDomain& domain, int f, const Eigen::VectorXd& x) {
+  const Eigen::Matrix2d J = face_jacobian(domain, f, x);
+  const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+  const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+  return {0.5 * (ps + pa), 0.5 * (ps - pa)};
+}
+
+double max_isometric_distortion(const LayoutDomain& domain, const Eigen::VectorXd& x) {
+  double s1max = 0, s2min = std::numeric_limits<double>::infinity();
+  for (int f = 0; f < domain.n_faces(); ++f) {
+    const Eigen::Vector2d s = face_singular_values(domain, f, x);
+    s1max = std::max(s1max, s[0]);
+    s2min = std::min(s2min, s[1]);
+  }
+  return s2min > 0 ? std::sqrt(s1max / s2min) : std::numeric_limits<double>::infinity();
+}
+
 Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd& x,
                                Density density, double power) {
   Eigen::VectorXd out(domain.n_faces());

@@ -110,6 +110,13 @@ Eigen::VectorXd face_densities(const LayoutDomain& domain, const Eigen::VectorXd
 // Jacobian of face f (rest frame → UV) in the layout x.
 Eigen::Matrix2d face_jacobian(const LayoutDomain& domain, int f, const Eigen::VectorXd& x);
 
+// Signed singular values (σ1 ≥ |σ2|, σ2 < 0 on a flip) of face f's Jacobian in the layout x.
+Eigen::Vector2d face_singular_values(const LayoutDomain& domain, int f, const Eigen::VectorXd& x);
+
+// The paper's τ (eq. 3) of the layout x: sqrt(max σ1 / min σ2); +inf when a face is flipped or
+// degenerate.
+double max_isometric_distortion(const LayoutDomain& domain, const Eigen::VectorXd& x);
+
 }  // namespace quadify::param
 
 namespace quadify::param {

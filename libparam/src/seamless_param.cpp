@@ -88,6 +88,9 @@ constexpr int kConePairPasses = 4;
 // With direction alignment, a cancellation may raise the map's mean angle to the directions by at
 // most this (degrees).
 constexpr double kMaxCancellationAngleLoss = 0.5;
+// A cancellation may raise the map's τ to at most max(floor, growth × τ before the pass).
+constexpr double kCancellationTauFloor = 5;
+constexpr double kCancellationTauGrowth = 2;
 
 // work(i) for i in [0, n): in parallel with TBB (independent items), else in order.
 template <class F>
@@ -437,6 +440,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         options.cone_pair_max_hops);
     if (pairs.empty()) break;
     const int cancelled_before = out.stats.n_cancelled_pairs;
+    const double tau_before = max_isometric_distortion(domain, x);
     std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
       if (begin >= end || failures >= kMaxCancellationFailures) return;
       std::vector<int> new_matching = matching;
@@ -484,7 +488,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         out.stats.n_batch_iterations += rep.iterations;
         add_timers(rep.timers, &out.stats);
         if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
-        ok = count_flipped(domain, x_try) == 0;
+        // Flip-free is not enough: a face the move squashed to a sliver (dragon: τ 3·10⁷) passes
+        // the exact orientation test and leaves quantization no room.
+        ok = count_flipped(domain, x_try) == 0 &&
+             max_isometric_distortion(domain, x_try) <=
+                 std::max(kCancellationTauFloor, kCancellationTauGrowth * tau_before);
         // With directions to follow, a set whose cones the field needs (its alignment gets
         // worse) is kept: on an ellipsoid with anisotropic sizing, cancelling 9 pairs raised the
         // map's angle to the principal directions from 5.7° to 14.4°.
@@ -564,11 +572,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       }
       if (round + 1 == kSoftFeatureRounds) break;
       auto stretch = [&](int f, const Eigen::VectorXd& xv) {
-        const Eigen::Matrix2d J = face_jacobian(domain, f, xv);
-        const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
-        const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
-        const double s1 = 0.5 * (ps + pa), s2 = 0.5 * (ps - pa);
-        return s2 > 0 ? std::max(s1, 1 / s2) : std::numeric_limits<double>::infinity();
+        const Eigen::Vector2d sv = face_singular_values(domain, f, xv);
+        return sv[1] > 0 ? std::max(sv[0], 1 / sv[1]) : std::numeric_limits<double>::infinity();
       };
       // Stretched by the features: beyond the bound, and clearly more than without them (faces
       // near cones may exceed the bound anyway).
@@ -673,23 +678,16 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   out.stats.n_aligned_features = static_cast<int>(out.features.size());
   // Flips (exact) and τ.
-  double s1max = 0, s2min = std::numeric_limits<double>::infinity();
   for (int f = 0; f < nf; ++f) {
     const Eigen::Vector2d a = out.corner_uv.row(3 * f), b = out.corner_uv.row(3 * f + 1),
                           c = out.corner_uv.row(3 * f + 2);
     if (core::orient2d(a, b, c) <= 0) ++out.stats.n_flipped;
-    const Eigen::Matrix2d J = face_jacobian(domain, f, x);
-    const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
-    const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
-    s1max = std::max(s1max, 0.5 * (ps + pa));
-    s2min = std::min(s2min, 0.5 * (ps - pa));
     const double sd =
-        evaluate_density(Density::kSymmetricDirichlet, 1, J, false, false).value;
+        evaluate_density(Density::kSymmetricDirichlet, 1, face_jacobian(domain, f, x), false, false).value;
     out.stats.sd_max = std::max(out.stats.sd_max, sd);
   }
-  out.stats.tau = out.stats.n_flipped > 0 || !(s2min > 0)
-                      ? std::numeric_limits<double>::infinity()
-                      : std::sqrt(s1max / s2min);
+  out.stats.tau = out.stats.n_flipped > 0 ? std::numeric_limits<double>::infinity()
+                                          : max_isometric_distortion(domain, x);
   // Cones: UV angle sums at interior vertices.
   const std::vector<int> index = vertex_indices(mesh, cut, x);
   for (int v = 0; v < mesh.n_vertices(); ++v)
