@@ -598,7 +598,7 @@ int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x) {
 TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
                                        const ConstraintEliminator& elim,
                                        const std::vector<SparseRow>& new_rows, double weight_unit,
-                                       Eigen::VectorXd* x, int n_fitted) {
+                                       Eigen::VectorXd* x, int n_fitted, int max_penalty_stages) {
   TransitionReport rep;
   const auto t_red = Clock::now();
   rep.reduction = elim.reduction(*x);
@@ -635,7 +635,9 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
     best_flips = count_flipped(domain, x_best);
   }
   std::unique_ptr<LayoutProblem> penalty_problem;  // shared by the penalty stages
-  for (double w = kFirstPenalty; w <= kLastPenalty && best_flips > 0; w *= kPenaltyGrowth) {
+  int stage = 0;
+  for (double w = kFirstPenalty; w <= kLastPenalty && best_flips > 0; w *= kPenaltyGrowth, ++stage) {
+    if (max_penalty_stages >= 0 && stage >= max_penalty_stages) break;
     if (max_residual(x_cur) > residual_tol) {
       OptimizeSettings st;
       st.max_iterations = kPenaltyIterations;

@@ -135,11 +135,13 @@ struct TransitionReport {
 // squares) onto the new space and checks orientations exactly; continues with larger w while
 // faces are flipped. weight_unit makes w dimensionless (area / Σ edge length²). The projections
 // fit the first n_fitted entries of x (−1: all), e.g. the copies when the other variables are
-// functions of them (seam translations).
+// functions of them (seam translations). max_penalty_stages bounds the penalty stages (−1: up
+// to w = 1e10), for callers to whom a failure costs nothing but the attempt.
 TransitionReport move_into_constraints(const LayoutDomain& domain, const Reduction& old_red,
                                        const ConstraintEliminator& elim,
                                        const std::vector<SparseRow>& new_rows, double weight_unit,
-                                       Eigen::VectorXd* x, int n_fitted = -1);
+                                       Eigen::VectorXd* x, int n_fitted = -1,
+                                       int max_penalty_stages = -1);
 
 // Faces with non-positive orientation of their three copies in x (exact predicate).
 int count_flipped(const LayoutDomain& domain, const Eigen::VectorXd& x);

@@ -91,6 +91,10 @@ constexpr double kMaxCancellationAngleLoss = 0.5;
 // A cancellation may raise the map's τ to at most max(floor, growth × τ before the pass).
 constexpr double kCancellationTauFloor = 5;
 constexpr double kCancellationTauGrowth = 2;
+// Penalty stages of a cancellation's move into its constraints (w = 1e3 … 1e5): a set that needs
+// more is rarely made flip-free by the rest of the ladder, and each failure costs a whole-mesh
+// homotopy (casting: 6 failures took 31 of the 43 s of its map).
+constexpr int kCancellationPenaltyStages = 3;
 
 // work(i) for i in [0, n): in parallel with TBB (independent items), else in order.
 template <class F>
@@ -468,7 +472,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
           edge_sq += seam_length(cut, s) * seam_length(cut, s);
         }
       TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows,
-                                                  total_area / edge_sq, &x_try, n_copy_vars);
+                                                  total_area / edge_sq, &x_try, n_copy_vars,
+                                                  kCancellationPenaltyStages);
       out.stats.total_iterations += tr.iterations;
       out.stats.n_transition_iterations += tr.iterations;
       add_timers(tr.timers, &out.stats);
