@@ -636,8 +636,9 @@ TransitionReport move_into_constraints(const LayoutDomain& domain, const Reducti
   }
   std::unique_ptr<LayoutProblem> penalty_problem;  // shared by the penalty stages
   int stage = 0;
-  for (double w = kFirstPenalty; w <= kLastPenalty && best_flips > 0; w *= kPenaltyGrowth, ++stage) {
-    if (max_penalty_stages >= 0 && stage >= max_penalty_stages) break;
+  for (double w = kFirstPenalty;
+       w <= kLastPenalty && best_flips > 0 && (max_penalty_stages < 0 || stage < max_penalty_stages);
+       w *= kPenaltyGrowth, ++stage) {
     if (max_residual(x_cur) > residual_tol) {
       OptimizeSettings st;
       st.max_iterations = kPenaltyIterations;

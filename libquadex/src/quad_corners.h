@@ -23,6 +23,14 @@ struct QuadCorners {
     return std::min(std::min(scaled_jacobian[0], scaled_jacobian[1]),
                     std::min(scaled_jacobian[2], scaled_jacobian[3]));
   }
+  Eigen::Vector3d centroid() const { return (p[0] + p[1] + p[2] + p[3]) / 4.0; }
+  // Cosine between the area vector and a surface normal (any length; 0 when either vanishes).
+  // The quad faces away from the surface when it is negative: the flip test of the metrics and
+  // the relaxation, with the normal of the surface triangle closest to centroid().
+  double facing_cosine(const Eigen::Vector3d& surface_normal) const {
+    const double denom = surface_normal.norm() * area_vector.norm();
+    return denom > 0 ? area_vector.dot(surface_normal) / denom : 0.0;
+  }
 };
 
 inline QuadCorners quad_corners(const core::PolyMesh& quads, int f) {

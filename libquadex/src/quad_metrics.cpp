@@ -306,7 +306,7 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
 
   // Per-quad scaled Jacobians and corner angles against the quad's area vector.
   std::vector<int> quad_faces;
-  std::vector<Eigen::Vector3d> quad_normal;
+  std::vector<QuadCorners> quad_geometry;
   std::vector<char> quad_flipped;
   double sj_sum = 0, angle_dev_sum = 0;
   int n_corners = 0;
@@ -315,7 +315,6 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
     if (quads.degree(f) != 4) continue;
     const QuadCorners corners = quad_corners(quads, f);
     const std::array<Eigen::Vector3d, 4>& p = corners.p;
-    const Eigen::Vector3d& area_vector = corners.area_vector;
     bool flipped = false;
     double quad_sj_min = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 4; ++k) {
@@ -335,7 +334,7 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
     sj_sum += quad_sj_min;
     m.sj_min = std::min(m.sj_min, quad_sj_min);
     quad_faces.push_back(f);
-    quad_normal.push_back(area_vector);
+    quad_geometry.push_back(corners);
     quad_flipped.push_back(flipped);
   }
   if (n_corners > 0) {
@@ -359,13 +358,12 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
       std::vector<double> angle_sum(quad_faces.size(), -1);
       parallel_for_each_index(quad_faces.size(), [&](size_t i) {
         const int f = quad_faces[i];
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (int k = 0; k < 4; ++k) centroid += quads.V.row(quads.vertex(f, k)).transpose() / 4.0;
+        const Eigen::Vector3d centroid = quad_geometry[i].centroid();
         const auto hit = ref.tree.closest_point_and_primitive(to_point(centroid));
         const Triangle& t = *hit.second;
         const Eigen::Vector3d a = to_eigen(t[0]);
         const Eigen::Vector3d ref_normal = (to_eigen(t[1]) - a).cross(to_eigen(t[2]) - a);
-        facing_away[i] = quad_normal[i].dot(ref_normal) < 0;
+        facing_away[i] = quad_geometry[i].facing_cosine(ref_normal) < 0;
         if (!options.curvature_alignment || !(ref_normal.norm() > 0)) return;
         const int rf = ref.face[static_cast<size_t>(hit.second - ref.triangles.begin())];
         int best = reference->F(rf, 0);

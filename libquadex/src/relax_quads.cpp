@@ -124,18 +124,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // moves that turn it around count as improvements.
   auto quad_quality = [&](int f) {
     const QuadCorners corners = quad_corners(q, f);
-    double quality = corners.min_scaled_jacobian();
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 4; ++k) centroid += corners.p[k] / 4.0;
-    const Triangle& t = *tree.closest_point_and_primitive(Point(centroid.x(), centroid.y(), centroid.z())).second;
+    const Eigen::Vector3d c = corners.centroid();
+    const Triangle& t = *tree.closest_point_and_primitive(Point(c.x(), c.y(), c.z())).second;
     const Kernel::Vector_3 n = CGAL::cross_product(t[1] - t[0], t[2] - t[0]);
-    const Eigen::Vector3d normal(n.x(), n.y(), n.z());
-    const double denom = normal.norm() * corners.area_vector.norm();
-    if (denom > 0) {
-      const double cosine = normal.dot(corners.area_vector) / denom;
-      if (cosine < 0) quality = std::min(quality, cosine);
-    }
-    return quality;
+    const double cosine = corners.facing_cosine(Eigen::Vector3d(n.x(), n.y(), n.z()));
+    return cosine < 0 ? std::min(corners.min_scaled_jacobian(), cosine) : corners.min_scaled_jacobian();
   };
   auto count_bad = [&](double threshold) {
     int n = 0;
