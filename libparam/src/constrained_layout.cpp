@@ -853,6 +853,34 @@ int PinnedLayout::minimize(int max_iterations, double relative_tolerance, core::
   return iterations;
 }
 
+std::vector<int> PinnedLayout::limiting_faces(const std::vector<std::pair<int, double>>& targets) {
+  Impl& m = *impl_;
+  std::vector<int> prescribed;
+  Eigen::VectorXd v = Eigen::VectorXd::Zero(m.n());
+  for (const auto& [j, value] : targets) {
+    if (j < 0 || j >= m.n() || m.state[j] != 0) continue;
+    m.state[j] = 2;
+    prescribed.push_back(j);
+    v[j] = value - m.y[j];
+  }
+  std::vector<int> out;
+  if (prescribed.empty()) return out;
+  Eigen::VectorXd g, Hv, dy;
+  m.evaluate(m.x, true, &g, &v, &Hv);
+  Eigen::VectorXd rhs = -Hv;
+  for (int i = 0; i < m.n(); ++i)
+    if (m.state[i] != 0) rhs[i] = v[i];
+  const bool solved = m.solve(rhs, &dy);
+  for (const int j : prescribed) m.state[j] = 0;
+  if (!solved) return out;
+  for (int i = 0; i < m.n(); ++i)
+    if (m.state[i] != 0) dy[i] = v[i];
+  const Eigen::VectorXd dx = m.red.P * dy;
+  for (int f = 0; f < m.domain.n_faces(); ++f)
+    if (flip_root(m.edge_matrix(m.x, f), m.edge_matrix(dx, f)) <= 1) out.push_back(f);
+  return out;
+}
+
 PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
                             const PinSettings& settings, int relax_iterations,
                             double relax_tolerance) {

@@ -26,8 +26,13 @@
 //    Aligned feature lines are optional candidates. They are rounded after the cones and before
 //    the translations (they get the first choice of the room), and a line that reaches no integer
 //    is released. If a translation then dead-ends (pinned lines in its way), the run is repeated
-//    with the lines rounded last, where they cannot block a required unknown; only if that too
-//    dead-ends are the features dropped.
+//    with the lines rounded last, where they cannot block a required unknown. A cone (in either
+//    order) or a translation (lines last) that still dead-ends has the alignment rows in its way
+//    released: the faces that would fold along the linear response of its move
+//    (PinnedLayout::limiting_faces) and, if no aligned edge lies on them, 1, 2, 4 or 8 vertex
+//    rings around them; the layout is rebuilt from the current one without those rows, the
+//    integers already reached are pinned again, and the stage goes on (casting: 77 of 632 edges
+//    released, the other 555 kept). Only if that fails too are the features dropped.
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
@@ -85,6 +90,11 @@ constexpr double kConePairMeshEdges = 8;
 // with features is rarely rescued by a jitter, and each attempt costs a full rounding run), in
 // both orders (feature lines before the translations, then after them).
 constexpr size_t kFeatureScaleTries = 1;
+// A rounding with features that dead-ends on a cone or a translation releases the alignment rows
+// on the faces that resist the blocked move (PinnedLayout::limiting_faces), or within the first
+// of kReleaseRings vertex rings of them that holds some, and goes on from where it stopped (at
+// most QuantizeOptions::feature_release_rounds times per run).
+constexpr int kReleaseRings[] = {0, 1, 2, 4, 8};
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
 constexpr double kFinalTolerance = 1e-7;
@@ -153,37 +163,48 @@ int count_flipped(const param::CopyLayout& cl, const Eigen::VectorXd& x, int nf)
   return n;
 }
 
+// Releases aligned feature rows near a dead end (see Rounder::release_near_dead_end): given the
+// faces that resist the blocked move, drops the alignment rows around them from *rows and their
+// ends from *candidates and *prefer_free_coords; returns the number of rows dropped (0: none).
+using ReleaseFeatures =
+    std::function<int(const std::vector<int>& faces, std::vector<param::AffineRow>* rows,
+                      std::vector<char>* prefer_free_coords, std::vector<Candidate>* candidates)>;
+
 // One rounding run at a fixed scale over a param::PinnedLayout (see the method note above).
 class Rounder {
  public:
   enum class Outcome { kDone, kStuck, kOutOfTime, kFailed };
 
   Rounder(const core::TriMesh& mesh, const param::CopyLayout& cl,
-          const std::vector<Candidate>& candidates, const std::vector<char>& is_cone_copy,
-          const QuantizeOptions& options, QuantizeStats* stats, Clock::time_point deadline,
-          std::string scale_label, bool features_last = false)
+          std::vector<Candidate> candidates, const std::vector<char>& is_cone_copy, const QuantizeOptions& options,
+          QuantizeStats* stats, Clock::time_point deadline, std::string scale_label,
+          bool features_last = false, ReleaseFeatures release = {})
       : mesh_(mesh),
         cl_(cl),
-        cand_(candidates),
+        cand_(std::move(candidates)),
         is_cone_copy_(is_cone_copy),
         opt_(options),
         stats_(stats),
         deadline_(deadline),
         label_(std::move(scale_label)),
-        features_last_(features_last) {}
+        features_last_(features_last),
+        release_(std::move(release)) {}
 
   Outcome run(const Eigen::VectorXd& x, const param::PinnedLayoutOptions& layout_options) {
+    lopt_ = layout_options;
     auto tc = Clock::now();
-    status_ = layout_.init(mesh_, cl_, x, layout_options);
+    status_ = layout_.init(mesh_, cl_, x, lopt_);
     stats_->seconds_setup += seconds_since(tc);
     if (!status_.is_ok()) return Outcome::kFailed;
     if (!find_integer_columns()) return Outcome::kFailed;
     tc = Clock::now();
     stats_->n_iterations += layout_.minimize(opt_.max_newton_iters, kBatchTolerance, &status_);
     if (!status_.is_ok()) return Outcome::kFailed;
-    Outcome outcome = round_cones();
+    // A dead end on a cone, or on a translation while the feature lines are still free, comes
+    // from the alignment rows in the way: those near it are released and the stage goes on.
+    Outcome outcome = with_release([this] { return round_cones(); });
     if (features_last_) {
-      if (outcome == Outcome::kDone) outcome = round_others();
+      if (outcome == Outcome::kDone) outcome = with_release([this] { return round_others(); });
       if (outcome == Outcome::kDone) outcome = round_features();
     } else {
       if (outcome == Outcome::kDone) outcome = round_features();
@@ -200,6 +221,8 @@ class Rounder {
     return layout_.n_flipped() == 0 ? Outcome::kDone : Outcome::kStuck;
   }
 
+  // The integer candidates of the run: those given, less the ends of released feature rows.
+  const std::vector<Candidate>& candidates() const { return cand_; }
   // Free columns left unpinned: feature lines that reached no integer (their features are not
   // on iso-lines; no required candidate depends on them).
   const std::vector<char>& released() const { return released_; }
@@ -212,6 +235,9 @@ class Rounder {
   const std::string& stuck_reason() const { return stuck_; }
   // Whether the dead end came while rounding the cones (which go first in either order).
   bool stuck_on_cones() const { return stuck_on_cones_; }
+  // Mesh faces that resist the move of the unknown the run dead-ended on
+  // (param::PinnedLayout::limiting_faces, for both neighbouring integers or grid points).
+  const std::vector<int>& stuck_faces() const { return stuck_faces_; }
 
  private:
   // A cone copy whose two coordinates are free variables.
@@ -243,6 +269,8 @@ class Rounder {
         return false;
       }
     }
+    int_cols_.clear();
+    cones_.clear();
     for (size_t j = 0; j < red.free_vars.size(); ++j)
       if (is_int_col[j]) int_cols_.push_back(static_cast<int>(j));
     // Feature columns, and the columns that required (cone and translation) candidates use: a
@@ -422,6 +450,12 @@ class Rounder {
       if (!placed) {
         const Eigen::Vector2d p = position(c);
         stuck_on_cones_ = true;
+        for (size_t a = 0; a < std::min(choices.size(), size_t{2}); ++a) {
+          std::vector<std::pair<int, double>> t;
+          if (!layout_.is_pinned(c.col_u)) t.push_back({c.col_u, choices[a].x()});
+          if (!layout_.is_pinned(c.col_v)) t.push_back({c.col_v, choices[a].y()});
+          add_stuck_faces(t);
+        }
         stuck_ = "cone vertex " + std::to_string(cl_.copy_vertex[c.copy]) + " at (" +
                  std::to_string(p.x()) + ", " + std::to_string(p.y()) +
                  ") reaches no free grid point flip-free";
@@ -530,6 +564,8 @@ class Rounder {
         if (const Outcome o = pin_neighbouring_integer(j, far, &placed); o != Outcome::kDone) return o;
       }
       if (!placed) {
+        add_stuck_faces({{j, std::floor(v)}});
+        add_stuck_faces({{j, std::floor(v) + 1}});
         stuck_ = "a seam translation at " + std::to_string(v) + " reaches no integer flip-free";
         return Outcome::kStuck;
       }
@@ -537,15 +573,70 @@ class Rounder {
     return Outcome::kDone;
   }
 
+  // Runs a rounding stage; while it dead-ends and feature rows near the dead end can be
+  // released (at most options.feature_release_rounds times), releases them and runs the stage
+  // again.
+  template <class Stage>
+  Outcome with_release(Stage stage) {
+    Outcome o = stage();
+    for (int round = 0; o == Outcome::kStuck && release_ && round < opt_.feature_release_rounds;
+         ++round) {
+      if (out_of_time()) return Outcome::kOutOfTime;
+      if (!release_near_dead_end()) return status_.is_ok() ? o : Outcome::kFailed;
+      o = stage();
+    }
+    return o;
+  }
+
+  // Drops the feature rows near the faces that resist the blocked move and rebuilds the layout
+  // from the current one: the elimination changes, so every integer column whose value the
+  // pinned columns determined (an integer) is pinned again at that value. False when no row is
+  // near the dead end or the rebuild fails (status_).
+  bool release_near_dead_end() {
+    if (stuck_faces_.empty()) return false;
+    const param::ConstrainedReduction& red = layout_.reduction();
+    std::vector<char> determined(red.P.rows(), 1);
+    for (int v = 0; v < red.P.rows(); ++v)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(red.P, v); it; ++it)
+        if (!layout_.is_pinned(static_cast<int>(it.col()))) determined[v] = 0;
+    const Eigen::VectorXd x_ext = layout_.x();
+    const int n = release_(stuck_faces_, &lopt_.extra_rows, &lopt_.prefer_free_coords, &cand_);
+    if (n == 0) return false;
+    const auto tc = Clock::now();
+    status_ = layout_.init(mesh_, cl_, x_ext.head(2 * cl_.n_copies()), lopt_);
+    stats_->seconds_setup += seconds_since(tc);
+    if (!status_.is_ok() || !find_integer_columns()) return false;
+    const param::ConstrainedReduction& red2 = layout_.reduction();
+    std::vector<std::pair<int, double>> targets;
+    for (const int j : int_cols_) {
+      const int v = red2.free_vars[j];
+      if (determined[v] && x_ext[v] == std::round(x_ext[v])) targets.push_back({j, x_ext[v]});
+    }
+    n_pinned_ = 0;
+    pin(targets);
+    stuck_faces_.clear();
+    stuck_.clear();
+    stuck_on_cones_ = false;
+    return status_.is_ok();
+  }
+
+  void add_stuck_faces(const std::vector<std::pair<int, double>>& targets) {
+    for (const int f : layout_.limiting_faces(targets)) stuck_faces_.push_back(f);
+    std::sort(stuck_faces_.begin(), stuck_faces_.end());
+    stuck_faces_.erase(std::unique(stuck_faces_.begin(), stuck_faces_.end()), stuck_faces_.end());
+  }
+
   const core::TriMesh& mesh_;
   const param::CopyLayout& cl_;
-  const std::vector<Candidate>& cand_;
+  std::vector<Candidate> cand_;
   const std::vector<char>& is_cone_copy_;
   const QuantizeOptions& opt_;
   QuantizeStats* stats_;
   Clock::time_point deadline_;
   std::string label_;
   bool features_last_;  // translations before feature lines (they cannot block a translation)
+  ReleaseFeatures release_;
+  param::PinnedLayoutOptions lopt_;
   param::PinnedLayout layout_;
   core::Status status_;
   std::vector<int> int_cols_;
@@ -555,6 +646,7 @@ class Rounder {
   int n_pinned_ = 0;
   std::string stuck_;
   bool stuck_on_cones_ = false;
+  std::vector<int> stuck_faces_;
 };
 
 // Whether a is a multiple of 2^-kMaxDenominatorBits (exactly).
@@ -600,11 +692,12 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   if (options.target_faces < 0 || !(options.edge_length >= 0) || !(options.threshold_step > 0) ||
       options.threshold_step > 0.5 || !(options.scale_growth > 1) ||
       options.max_scale_retries < 0 || options.near_scale_tries < 0 ||
-      !(options.time_budget_seconds >= 0) ||
+      options.feature_release_rounds < 0 || !(options.time_budget_seconds >= 0) ||
       !(options.near_scale_step >= 0 && options.near_scale_step < 0.2)) {
     out.status = core::Status::invalid_input(
         "quantize options: need target_faces ≥ 0, edge_length ≥ 0, 0 < threshold_step ≤ 0.5, "
-        "scale_growth > 1, max_scale_retries ≥ 0, near_scale_tries ≥ 0, 0 ≤ near_scale_step < 0.2");
+        "scale_growth > 1, max_scale_retries ≥ 0, near_scale_tries ≥ 0, feature_release_rounds ≥ 0, "
+        "0 ≤ near_scale_step < 0.2");
     return out;
   }
   if (nf == 0 || seamless.uv.corner_uv.rows() != 3 * nf) {
@@ -654,38 +747,60 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       candidates.push_back({{{n_copy_vars + 2 * static_cast<int>(si) + d, 1.0}}, false});
   // Aligned features (param::FeatureAlignment): the constant coordinate of both ends is an
   // integer candidate, and the alignment rows are eliminated with the seams.
-  std::vector<param::AffineRow> feature_rows;
+  struct FeatureRow {
+    param::AffineRow row;
+    int face, a, b, coord;  // its face, the copies of its ends and the constant coordinate
+  };
+  std::vector<FeatureRow> feature_rows;
   const size_t n_base_candidates = candidates.size();
-  {
+  for (const param::FeatureAlignment& fa : seamless.features) {
+    if (fa.face < 0 || fa.face >= nf || fa.corner < 0 || fa.corner > 2 || fa.constant_coord < 0 ||
+        fa.constant_coord > 1) {
+      out.status = core::Status::invalid_input("feature alignment on face " + std::to_string(fa.face) +
+                                               " is out of range");
+      return out;
+    }
+    const int a = cl.corner_copy[3 * fa.face + fa.corner];
+    const int b = cl.corner_copy[3 * fa.face + (fa.corner + 1) % 3];
+    const int c = fa.constant_coord;
+    const double scale_ref = std::max({1.0, std::abs(cl.x[2 * a + c]), std::abs(cl.x[2 * b + c])});
+    if (std::abs(cl.x[2 * b + c] - cl.x[2 * a + c]) > options.input_seam_tol * scale_ref * 1e3) {
+      out.status = core::Status::invalid_input("feature edge on face " + std::to_string(fa.face) +
+                                               " is not aligned with its axis in the input map");
+      return out;
+    }
+    FeatureRow fr{{}, fa.face, a, b, c};
+    fr.row.entries = {{2 * a + c, -1.0}, {2 * b + c, 1.0}};
+    feature_rows.push_back(fr);
+  }
+  // The feature rows kept so far (rows near a dead end are released, see below), and for them
+  // the alignment rows, the candidates (base ones, then the ends' constant coordinates) and the
+  // coordinates the elimination should keep free.
+  std::vector<char> feature_kept(feature_rows.size(), 1);
+  std::vector<param::AffineRow> kept_rows;
+  std::vector<char> feature_coords;
+  auto select_features = [&]() {
+    candidates.resize(n_base_candidates);
+    kept_rows.clear();
     std::vector<char> is_candidate(n_copy_vars, 0);
     for (const Candidate& c : candidates)
       if (c.is_cone) is_candidate[c.form[0].first] = 1;
-    for (const param::FeatureAlignment& fa : seamless.features) {
-      if (fa.face < 0 || fa.face >= nf || fa.corner < 0 || fa.corner > 2 || fa.constant_coord < 0 ||
-          fa.constant_coord > 1) {
-        out.status = core::Status::invalid_input("feature alignment on face " + std::to_string(fa.face) +
-                                                 " is out of range");
-        return out;
-      }
-      const int a = cl.corner_copy[3 * fa.face + fa.corner];
-      const int b = cl.corner_copy[3 * fa.face + (fa.corner + 1) % 3];
-      const int c = fa.constant_coord;
-      const double scale_ref = std::max({1.0, std::abs(cl.x[2 * a + c]), std::abs(cl.x[2 * b + c])});
-      if (std::abs(cl.x[2 * b + c] - cl.x[2 * a + c]) > options.input_seam_tol * scale_ref * 1e3) {
-        out.status = core::Status::invalid_input("feature edge on face " + std::to_string(fa.face) +
-                                                 " is not aligned with its axis in the input map");
-        return out;
-      }
-      param::AffineRow row;
-      row.entries = {{2 * a + c, -1.0}, {2 * b + c, 1.0}};
-      feature_rows.push_back(row);
-      for (const int k : {a, b})
-        if (!is_candidate[2 * k + c]) {
-          is_candidate[2 * k + c] = 1;
-          candidates.push_back({{{2 * k + c, 1.0}}, false, k, c, true});
+    feature_coords.assign(n_copy_vars, 0);
+    for (size_t r = 0; r < feature_rows.size(); ++r) {
+      if (!feature_kept[r]) continue;
+      const FeatureRow& fr = feature_rows[r];
+      kept_rows.push_back(fr.row);
+      for (const int k : {fr.a, fr.b}) {
+        // Cone coordinates are candidates already (and keep their own pivot preference).
+        if (!is_candidate[2 * k + fr.coord]) {
+          feature_coords[2 * k + fr.coord] = 1;
+          is_candidate[2 * k + fr.coord] = 1;
+          candidates.push_back({{{2 * k + fr.coord, 1.0}}, false, k, fr.coord, true});
         }
+      }
     }
-  }
+  };
+  select_features();
   st.n_candidates = static_cast<int>(candidates.size());
 
   // Scale.
@@ -721,12 +836,6 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   lopt.direction_weight = options.direction_weight;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
-  std::vector<char> feature_coords;
-  if (!feature_rows.empty()) {
-    feature_coords.assign(n_copy_vars, 0);
-    for (const Candidate& c : candidates)
-      if (!c.is_cone && c.copy >= 0) feature_coords[2 * c.copy + c.coord] = 1;
-  }
   const std::vector<Candidate> base_candidates(candidates.begin(),
                                                candidates.begin() + n_base_candidates);
   const Clock::time_point deadline =
@@ -754,6 +863,52 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     bool with_features, features_last;
   };
   std::vector<Attempt> attempts;
+  // Releases the kept feature rows on the faces of the first of kReleaseRings vertex-ring
+  // neighbourhoods of `faces` that holds some (see ReleaseFeatures).
+  std::vector<std::vector<int>> vertex_faces;
+  const ReleaseFeatures release = [&](const std::vector<int>& faces,
+                                      std::vector<param::AffineRow>* rows,
+                                      std::vector<char>* prefer_free_coords,
+                                      std::vector<Candidate>* attempt_candidates) {
+    if (vertex_faces.empty()) {
+      vertex_faces.resize(mesh.n_vertices());
+      for (int f = 0; f < nf; ++f)
+        for (int k = 0; k < 3; ++k) vertex_faces[mesh.F(f, k)].push_back(f);
+    }
+    std::vector<char> in_region(nf, 0);
+    std::vector<int> front;
+    for (const int f : faces)
+      if (f >= 0 && f < nf && !in_region[f]) {
+        in_region[f] = 1;
+        front.push_back(f);
+      }
+    int n = 0, grown = 0;
+    for (const int rings : kReleaseRings) {
+      for (; grown < rings; ++grown) {
+        std::vector<int> next;
+        for (const int f : front)
+          for (int k = 0; k < 3; ++k)
+            for (const int g : vertex_faces[mesh.F(f, k)])
+              if (!in_region[g]) {
+                in_region[g] = 1;
+                next.push_back(g);
+              }
+        front = std::move(next);
+      }
+      for (size_t r = 0; r < feature_rows.size(); ++r)
+        if (feature_kept[r] && in_region[feature_rows[r].face]) {
+          feature_kept[r] = 0;
+          ++n;
+        }
+      if (n > 0) break;
+    }
+    if (n == 0) return 0;
+    select_features();
+    *rows = kept_rows;
+    *prefer_free_coords = feature_coords;
+    *attempt_candidates = candidates;
+    return n;
+  };
   if (!feature_rows.empty())
     for (size_t i = 0; i < std::min<size_t>(kFeatureScaleTries, scales.size()); ++i) {
       attempts.push_back({scales[i], true, false});
@@ -764,7 +919,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     st.n_scale_retries = attempt;
     scale = attempts[attempt].scale;
     const bool with_features = attempts[attempt].with_features;
-    lopt.extra_rows = with_features ? feature_rows : std::vector<param::AffineRow>{};
+    lopt.extra_rows = with_features ? kept_rows : std::vector<param::AffineRow>{};
     lopt.prefer_free_coords = with_features ? feature_coords : std::vector<char>{};
     const std::vector<Candidate>& attempt_candidates = with_features ? candidates : base_candidates;
     // Scaled copies, each component translated so that its gauge copy is at the origin.
@@ -778,7 +933,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                   with_features ? (attempts[attempt].features_last ? " features-last" : "")
                                 : (feature_rows.empty() ? "" : " no-features"));
     Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st, deadline, label,
-                    attempts[attempt].features_last);
+                    attempts[attempt].features_last, with_features ? release : ReleaseFeatures{});
     const Rounder::Outcome outcome = rounder.run(x, lopt);
     st.n_integer_dofs = rounder.n_integer_columns();
     if (outcome == Rounder::Outcome::kFailed) {
@@ -818,7 +973,10 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     st.features_dropped = !feature_rows.empty() && !with_features;
     if (!st.features_dropped) st.features_dropped_reason.clear();
     st.n_released_feature_lines = rounder.n_released();
-    if (!with_features) candidates.resize(n_base_candidates);
+    st.n_released_feature_edges =
+        with_features ? static_cast<int>(std::count(feature_kept.begin(), feature_kept.end(), 0))
+                      : 0;
+    candidates = rounder.candidates();
     st.n_candidates = static_cast<int>(candidates.size());
     best = xe;
     break;
@@ -864,7 +1022,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   for (int c = 0; c < 3 * nf; ++c)
     out.uv.corner_uv.row(c) = x.segment<2>(2 * cl.corner_copy[c]).transpose();
   if (!st.features_dropped)
-    for (const param::AffineRow& row : feature_rows) {
+    for (const FeatureRow& fr : feature_rows) {
+      const param::AffineRow& row = fr.row;
       const double v = x[row.entries[0].first];
       st.n_aligned_features += v == std::round(v) && x[row.entries[1].first] == v;
     }

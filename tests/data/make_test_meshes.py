@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the small clean test meshes of tests/data (stdlib only, deterministic):
 tet.obj, cube.obj (12 triangles), sphere.obj (icosphere, 1280 triangles), disk.obj (open,
-200 triangles), torus.obj (800 triangles). spot.obj is copied from examples/data."""
+200 triangles), torus.obj (800 triangles), box.obj, plate.obj (genus 5, sharp hole walls).
+spot.obj is copied from examples/data."""
 import math
 import os
 
@@ -64,6 +65,49 @@ def box(size=(1.0, 0.75, 0.5), cell=0.125):
                         f += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
                     else:
                         f += [(q[0], q[1], q[3]), (q[1], q[2], q[3])]
+    return v, f
+
+
+def plate(n=16, layers=2, thickness=0.05, holes=((2, 4, 2, 4), (12, 14, 2, 4), (2, 4, 12, 14),
+                                                      (12, 14, 12, 14), (7, 9, 7, 9))):
+    """Unit square plate of `layers` x `thickness` with square holes (cell ranges i0:i1, j0:j1 of
+    an n x n grid): the boundary of a union of grid cells, each exposed cell side split into two
+    triangles along alternating diagonals. Genus = number of holes; every hole wall is sharp."""
+    xs = [i / n for i in range(n + 1)]
+    zs = [thickness * k for k in range(layers + 1)]
+    cells = {(i, j, k) for i in range(n) for j in range(n) for k in range(layers)
+             if not any(i0 <= i < i1 and j0 <= j < j1 for i0, i1, j0, j1 in holes)}
+    index = {}
+    v, f = [], []
+
+    def vid(p):
+        if p not in index:
+            index[p] = len(v)
+            v.append((xs[p[0]], xs[p[1]], zs[p[2]]))
+        return index[p]
+
+    for c in sorted(cells):
+        for axis in range(3):
+            a, b = (axis + 1) % 3, (axis + 2) % 3
+            for side in (0, 1):
+                nb = list(c)
+                nb[axis] += 1 if side else -1
+                if tuple(nb) in cells:
+                    continue
+
+                def pt(da, db):
+                    p = list(c)
+                    p[axis] += side
+                    p[a] += da
+                    p[b] += db
+                    return vid(tuple(p))
+                q = [pt(0, 0), pt(1, 0), pt(1, 1), pt(0, 1)]
+                if side == 0:
+                    q = q[::-1]
+                if sum(c) % 2 == 0:
+                    f += [(q[0], q[1], q[2]), (q[0], q[2], q[3])]
+                else:
+                    f += [(q[0], q[1], q[3]), (q[1], q[2], q[3])]
     return v, f
 
 
@@ -135,3 +179,4 @@ if __name__ == "__main__":
     write_obj("sphere.obj", *icosphere(3), "icosphere level 3, 1280 triangles, genus 0")
     write_obj("disk.obj", *disk(), "open disk, 198 triangles, 1 boundary loop")
     write_obj("torus.obj", *torus(), "torus 20x20, 800 triangles, genus 1")
+    write_obj("plate.obj", *plate(), "plate 1 x 1 x 0.1 with 5 square holes, genus 5, sharp edges")

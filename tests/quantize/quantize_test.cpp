@@ -17,6 +17,8 @@ namespace {
 // Quad count within this fraction of the target (the scale is set from the UV area; the
 // flip-free re-optimization changes the area only slightly).
 constexpr double kQuadCountTolerance = 0.10;
+// A coarse target for tests/data/plate.obj, where its creases do not all fit the grid.
+constexpr int kPlateTarget = 120;
 
 core::TriMesh load(const std::string& name) {
   return core::to_trimesh(core::read_mesh(test::data_path(name)));
@@ -71,7 +73,8 @@ struct FeatureRun {
   quantize::QuantizeResult quantized;
   quadex::ExtractResult quads;
 };
-FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundaries) {
+FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundaries,
+                             const quantize::QuantizeOptions& base = {}) {
   FeatureRun run;
   param::ParamOptions po;
   po.energy = param::Energy::kSymmetricDirichlet;
@@ -81,7 +84,7 @@ FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundar
   po.align_boundaries = boundaries;
   run.param = param::compute_seamless_param(mesh, po);
   if (!run.param.status.is_ok()) return run;
-  quantize::QuantizeOptions qo;
+  quantize::QuantizeOptions qo = base;
   qo.target_faces = target;
   run.quantized = quantize::quantize_seamless(mesh, run.param, qo);
   if (run.quantized.status.is_ok()) run.quads = quadex::extract_quads(run.quantized.uv);
@@ -115,6 +118,41 @@ TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
   EXPECT_EQ(qm.n_irregular, 8) << "one valence-3 vertex per box corner";
   EXPECT_GE(qm.feature_capture, 0.999);
   EXPECT_LT(qm.hausdorff_sym, 1e-9) << "quads on the box's flat sides";
+}
+
+// A plate with five square holes at a coarse grid: the holes are about a quad wide, and with
+// every crease aligned some translation around a hole has no flip-free integer. Only the
+// alignment rows near that dead end are released; the rest of the creases stay on iso-lines.
+TEST(QuantizeSeamless, FeaturesNearADeadEndAreReleasedTheRestKept) {
+  const core::TriMesh mesh = load("plate.obj");
+  quantize::QuantizeOptions all_or_nothing;
+  all_or_nothing.feature_release_rounds = 0;
+  const FeatureRun dropped = run_with_features(mesh, kPlateTarget, false, all_or_nothing);
+  ASSERT_TRUE(dropped.param.status.is_ok()) << dropped.param.status.to_string();
+  ASSERT_TRUE(dropped.quantized.status.is_ok()) << dropped.quantized.status.to_string();
+  ASSERT_TRUE(dropped.quantized.stats.features_dropped)
+      << "the plate must dead-end with all its creases";
+
+  const FeatureRun run = run_with_features(mesh, kPlateTarget, false);
+  ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();
+  const quantize::QuantizeStats& st = run.quantized.stats;
+  const int n_rows = static_cast<int>(run.param.features.size());
+  EXPECT_FALSE(st.features_dropped) << st.features_dropped_reason;
+  EXPECT_GT(st.n_released_feature_edges, 0);
+  EXPECT_LT(st.n_released_feature_edges, n_rows / 2);
+  EXPECT_GE(st.n_aligned_features, n_rows / 2);
+  EXPECT_EQ(st.n_flipped, 0);
+  EXPECT_EQ(test::integer_seamless_violation(run.quantized.uv), "");
+  ASSERT_TRUE(run.quads.status.is_ok()) << run.quads.status.to_string();
+  const quadex::QuadMetrics qm = quadex::compute_quad_metrics(run.quads.quads, &mesh);
+  EXPECT_EQ(qm.n_non_quads, 0);
+  EXPECT_TRUE(qm.manifold);
+  EXPECT_EQ(qm.n_flipped, 0);
+  EXPECT_EQ(qm.euler_characteristic, core::topology_stats(mesh).euler_characteristic);
+  const quadex::QuadMetrics dropped_qm =
+      quadex::compute_quad_metrics(dropped.quads.quads, &mesh);
+  EXPECT_GT(qm.feature_capture, dropped_qm.feature_capture + 0.2)
+      << "kept: " << qm.feature_capture << ", all dropped: " << dropped_qm.feature_capture;
 }
 
 TEST(QuantizeSeamless, AlignedDiskBoundaryGivesPureQuads) {
@@ -321,6 +359,41 @@ TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
     EXPECT_EQ(blocked.blocking[i], 1) << i;
   }
   EXPECT_EQ(layout.n_flipped(), 0);
+}
+
+TEST(PinnedLayout, LimitingFacesAreAroundAMoveThatFolds) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  param::CopyLayout cl;
+  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  param::PinnedLayout layout;
+  ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, {}).is_ok());
+  // A copy whose u is a free variable; the faces around its vertex.
+  const param::ConstrainedReduction& red = layout.reduction();
+  std::vector<int> col_of(red.P.rows(), -1);
+  for (size_t c = 0; c < red.free_vars.size(); ++c) col_of[red.free_vars[c]] = static_cast<int>(c);
+  int copy = -1;
+  for (int k = 0; k < cl.n_copies() && copy < 0; ++k)
+    if (col_of[2 * k] >= 0) copy = k;
+  ASSERT_GE(copy, 0);
+  const int j = col_of[2 * copy];
+  const Eigen::VectorXd y0 = layout.y();
+  // A hundredth of a unit: nothing limits it. A hundred units: the faces around the copy (and
+  // no others, since the rest follows smoothly) fold first.
+  EXPECT_TRUE(layout.limiting_faces({{j, y0[j] + 0.01}}).empty());
+  const std::vector<int> limiting = layout.limiting_faces({{j, y0[j] + 100}});
+  ASSERT_FALSE(limiting.empty());
+  const int v = cl.copy_vertex[copy];
+  bool around = false;
+  for (const int f : limiting)
+    for (int k = 0; k < 3; ++k) around = around || mesh.F(f, k) == v;
+  EXPECT_TRUE(around);
+  EXPECT_LT(limiting.size(), static_cast<size_t>(mesh.n_faces()));
+  // The query moves nothing and pins nothing.
+  EXPECT_EQ(layout.y(), y0);
+  EXPECT_FALSE(layout.is_pinned(j));
+  EXPECT_TRUE(layout.limiting_faces({{-1, 0.0}}).empty()) << "out of range: ignored";
 }
 
 TEST(ConstrainedLayout, CopiesAndAffineRowsOnTheSphere) {

@@ -111,6 +111,11 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
     progress.end();
   }
+  if (integer_map.status.is_ok() && integer_map.stats.n_released_feature_edges > 0 && !common.quiet)
+    std::fprintf(stderr,
+                 "quadify: %s: %d aligned feature edges near dead ends of the rounding were released "
+                 "(not on quad edges; a larger --target-faces may keep them)\n",
+                 args.input.c_str(), integer_map.stats.n_released_feature_edges);
   if (!integer_map.status.is_ok())
     throw CliError{kExitInternal,
                    args.input + ": quantization failed: " + integer_map.status.to_string() +
@@ -169,6 +174,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
                         {"aligned_features", qs.n_aligned_features},
                         {"released_feature_lines", qs.n_released_feature_lines},
+                        {"released_feature_edges", qs.n_released_feature_edges},
                         {"features_dropped", features_dropped || qs.features_dropped},
                         {"features_dropped_reason", features_dropped ? features_dropped_reason
                                                                      : qs.features_dropped_reason},

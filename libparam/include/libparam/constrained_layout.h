@@ -219,6 +219,12 @@ class PinnedLayout {
   // determine positively oriented (exact predicate); pin() drops targets that fail this.
   bool determined_faces_valid(const std::vector<std::pair<int, double>>& targets) const;
 
+  // Faces (mesh face ids) that flip or degenerate along the linear response to moving the free
+  // variables of `targets` to their values (one Newton solve with their displacement prescribed,
+  // the other free variables following): where the layout resists the move. Used to locate what
+  // blocks a target that pin() could not reach. Empty when nothing limits the full step.
+  std::vector<int> limiting_faces(const std::vector<std::pair<int, double>>& targets);
+
   // Flip-free Newton minimisation of the energy over the unpinned variables. Returns the number
   // of iterations; *status is kNumericalFailure when a factorization fails.
   int minimize(int max_iterations, double relative_tolerance, core::Status* status);

@@ -37,6 +37,12 @@ struct QuantizeOptions {
   double near_scale_step = 0.02;
   int max_scale_retries = 3;
   double scale_growth = 1.25;
+  // Aligned features: when the rounding dead-ends on a cone, or on a seam translation with the
+  // feature lines still free, the alignment rows on the faces that resist the blocked move (or
+  // within a few vertex rings of them) are released and the rounding goes on; after this many
+  // releases in one run the next attempt starts (features rounded last, then none). 0: any dead
+  // end drops to the next attempt.
+  int feature_release_rounds = 32;
   // Allowed seam residual of the input |e_b − R^r e_a|, × its UV bounding-box diagonal.
   double input_seam_tol = 1e-6;
   // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
@@ -72,11 +78,15 @@ struct QuantizeStats {
   int n_cones = 0;
   // Aligned features of the input map (param::FeatureAlignment) that the result has exactly on
   // integer iso-lines. Feature lines that reach no integer flip-free are released (left where
-  // they are; n_released_feature_lines), unless a cone or translation depends on them; when the
-  // rounding still dead-ends at the target scale, all features are dropped (features_dropped) and
-  // the map is quantized without them.
+  // they are; n_released_feature_lines), unless a cone or translation depends on them. A cone or
+  // translation that dead-ends releases the alignment of the feature edges in its way
+  // (n_released_feature_edges); when the rounding still dead-ends at the target scale, all
+  // features are dropped (features_dropped) and the map is quantized without them.
   int n_aligned_features = 0;
   int n_released_feature_lines = 0;
+  // Aligned feature edges whose alignment was released near a dead end of the rounding (see
+  // QuantizeOptions::feature_release_rounds; 0 when the features were dropped).
+  int n_released_feature_edges = 0;
   bool features_dropped = false;
   std::string features_dropped_reason;  // why the rounding with the features dead-ended
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
