@@ -31,8 +31,9 @@
 //    released: the faces that would fold along the linear response of its move
 //    (PinnedLayout::limiting_faces) and, if no aligned edge lies on them, 1, 2, 4 or 8 vertex
 //    rings around them; the layout is rebuilt from the current one without those rows, the
-//    integers already reached are pinned again, and the stage goes on (casting: 77 of 632 edges
-//    released, the other 555 kept). Only if that fails too are the features dropped.
+//    integers already reached are pinned again, and the stage goes on (casting at 5,000 quads:
+//    8 of 632 aligned edges released, 623 end on iso-lines). Only if that fails too are the
+//    features dropped.
 // 4. Exactness. The free variables y are rounded to multiples of 2^-30 and x = P·y + c is
 //    evaluated with P, c dyadic (integers, or halves where a pivot of 2 was unavoidable): every
 //    term and partial sum is a multiple of 2^-38 far below 2^53 ulps, so the evaluation is exact
