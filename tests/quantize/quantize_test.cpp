@@ -311,14 +311,31 @@ TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
   EXPECT_GT(n_checked, 0);
 }
 
-TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
-  const core::TriMesh mesh = load("sphere.obj");
-  const param::ParamResult p = param::compute_seamless_param(mesh);
-  ASSERT_TRUE(p.status.is_ok());
+// The sphere's seamless map at 10× scale in a PinnedLayout (for the PinnedLayout tests).
+struct SphereLayout {
+  core::TriMesh mesh = load("sphere.obj");
   param::CopyLayout cl;
-  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
   param::PinnedLayout layout;
-  ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, {}).is_ok());
+  bool ok = false;  // the map, the copies and the layout were built
+  SphereLayout() {
+    const param::ParamResult p = param::compute_seamless_param(mesh);
+    ok = p.status.is_ok() &&
+         param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok() &&
+         layout.init(mesh, cl, 10 * cl.x, {}).is_ok();
+  }
+};
+
+// Per variable of x = P·y + c: its free column, or -1.
+std::vector<int> column_of_variable(const param::ConstrainedReduction& red) {
+  std::vector<int> col_of(red.P.rows(), -1);
+  for (size_t c = 0; c < red.free_vars.size(); ++c) col_of[red.free_vars[c]] = static_cast<int>(c);
+  return col_of;
+}
+
+TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
+  SphereLayout sphere;
+  auto& [mesh, cl, layout, ready] = sphere;
+  ASSERT_TRUE(ready);
   ASSERT_EQ(layout.n_flipped(), 0);
   // A free variable a tenth of a unit away from where it is.
   const int j = layout.n_free() / 2;
@@ -333,8 +350,7 @@ TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
   // Both coordinates of the three copies of one face onto one line: the face is determined by
   // its targets and degenerate, so the targets block and the layout stays flip-free.
   const param::ConstrainedReduction& red = layout.reduction();
-  std::vector<int> col_of(red.P.rows(), -1);
-  for (size_t c = 0; c < red.free_vars.size(); ++c) col_of[red.free_vars[c]] = static_cast<int>(c);
+  const std::vector<int> col_of = column_of_variable(red);
   int face = -1;
   for (int f = 0; f < mesh.n_faces() && face < 0; ++f) {
     bool all_free = true;
@@ -362,17 +378,12 @@ TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
 }
 
 TEST(PinnedLayout, LimitingFacesAreAroundAMoveThatFolds) {
-  const core::TriMesh mesh = load("sphere.obj");
-  const param::ParamResult p = param::compute_seamless_param(mesh);
-  ASSERT_TRUE(p.status.is_ok());
-  param::CopyLayout cl;
-  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
-  param::PinnedLayout layout;
-  ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, {}).is_ok());
+  SphereLayout sphere;
+  auto& [mesh, cl, layout, ready] = sphere;
+  ASSERT_TRUE(ready);
   // A copy whose u is a free variable; the faces around its vertex.
   const param::ConstrainedReduction& red = layout.reduction();
-  std::vector<int> col_of(red.P.rows(), -1);
-  for (size_t c = 0; c < red.free_vars.size(); ++c) col_of[red.free_vars[c]] = static_cast<int>(c);
+  const std::vector<int> col_of = column_of_variable(red);
   int copy = -1;
   for (int k = 0; k < cl.n_copies() && copy < 0; ++k)
     if (col_of[2 * k] >= 0) copy = k;
