@@ -324,6 +324,25 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
   EXPECT_EQ(report["quads"]["components_lost"], 1);
 }
 
+// At 12 quads the torus's tube is about one quad around: the first grid has a loop of a single
+// quad around it (quads that meet themselves, not manifold). The remesher quantizes again on a
+// finer grid until the quads are manifold, says so, and counts the refinements in the report.
+TEST_F(CliTest, RemeshRefinesAGridThatPinchesAHandle) {
+  const std::string torus = data_path("torus.obj").string();
+  const fs::path out = dir_ / "torus_quads.obj";
+  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
+  args.append("'").append(torus).append("' -o '").append(out.string());
+  args.append("' --target-faces 12 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("are not manifold"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_GE(report["quantize"]["refinements"].get<int>(), 1);
+  EXPECT_EQ(report["quads"]["manifold"], true);
+  EXPECT_EQ(report["quads"]["genus"], 1) << "the handle is kept";
+  EXPECT_EQ(report["quads"]["non_quads"], 0);
+}
+
 // tests/data/sphere.obj stretched to the ellipsoid (3, 1, 1), written to `path`.
 void write_ellipsoid(const fs::path& path) {
   std::ostringstream obj;

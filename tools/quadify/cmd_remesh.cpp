@@ -35,6 +35,22 @@ struct RemeshArgs {
   SizingArgs sizing;
 };
 
+// A handle thinner than about one quad can get a loop of a single quad around it: the extracted
+// mesh then has quads that meet themselves (not manifold). The quantization is then run again on
+// a grid with kRefineFactor times as many quads, at most kMaxRefinements times.
+constexpr int kMaxRefinements = 3;
+constexpr double kRefineFactor = 1.3;
+
+// The same density request kRefineFactor times finer (more quads).
+void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {
+  if (options->target_faces > 0) {
+    options->target_faces = static_cast<int>(std::lround(options->target_faces * kRefineFactor));
+  } else if (options->edge_length > 0) {
+    options->edge_length /= std::sqrt(kRefineFactor);
+  } else {
+    options->edge_length = quantize::target_edge_length(mesh, *options) / std::sqrt(kRefineFactor);
+  }
+}
 
 
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
@@ -130,6 +146,27 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   progress.end();
   if (!extracted.status.is_ok())
     throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
+  int refinements = 0;
+  for (; refinements < kMaxRefinements && !quadex::compute_quad_metrics(extracted.quads).manifold;
+       ++refinements) {
+    const int faces_before = extracted.stats.n_faces;
+    refine_density(mesh, &quantize_options);
+    progress.begin("quantize");
+    quantize::QuantizeResult finer = quantize::quantize_seamless(mesh, seamless, quantize_options);
+    progress.end();
+    if (!finer.status.is_ok()) break;
+    progress.begin("extract");
+    quadex::ExtractResult finer_quads = quadex::extract_quads(finer.uv, extract_options);
+    progress.end();
+    if (!finer_quads.status.is_ok()) break;
+    if (!common.quiet)
+      std::fprintf(stderr,
+                   "quadify: %s: the %d quads are not manifold (a handle thinner than about a quad "
+                   "has a loop of one quad around it); quantized again on a finer grid: %d quads\n",
+                   args.input.c_str(), faces_before, finer_quads.stats.n_faces);
+    integer_map = std::move(finer);
+    extracted = std::move(finer_quads);
+  }
   quadex::RelaxStats relax_stats;
   if (args.relax) {
     progress.begin("relax");
@@ -175,6 +212,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                         {"aligned_features", qs.n_aligned_features},
                         {"released_feature_lines", qs.n_released_feature_lines},
                         {"released_feature_edges", qs.n_released_feature_edges},
+                        {"refinements", refinements},
                         {"features_dropped", features_dropped || qs.features_dropped},
                         {"features_dropped_reason", features_dropped ? features_dropped_reason
                                                                      : qs.features_dropped_reason},
