@@ -915,7 +915,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       attempts.push_back({scales[i], true, false});
       attempts.push_back({scales[i], true, true});
     }
-  for (const double sc : scales) attempts.push_back({sc, false, false});
+  if (feature_rows.empty() || options.quantize_without_features)
+    for (const double sc : scales) attempts.push_back({sc, false, false});
   for (int attempt = 0; attempt < static_cast<int>(attempts.size()); ++attempt) {
     st.n_scale_retries = attempt;
     scale = attempts[attempt].scale;
@@ -983,6 +984,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     break;
   }
   if (!best) {
+    st.features_dropped = !feature_rows.empty() && failure.is_ok() && !last_stuck.empty();
     out.status = failure.is_ok()
                      ? core::Status::not_converged(
                            "no flip-free integer-seamless map within " +

@@ -132,6 +132,14 @@ TEST(QuantizeSeamless, FeaturesNearADeadEndAreReleasedTheRestKept) {
   ASSERT_TRUE(dropped.quantized.status.is_ok()) << dropped.quantized.status.to_string();
   ASSERT_TRUE(dropped.quantized.stats.features_dropped)
       << "the plate must dead-end with all its creases";
+  // A caller that parametrizes again without the features can have the quantization stop there.
+  quantize::QuantizeOptions stop = all_or_nothing;
+  stop.target_faces = kPlateTarget;
+  stop.quantize_without_features = false;
+  const quantize::QuantizeResult stopped = quantize::quantize_seamless(mesh, dropped.param, stop);
+  EXPECT_EQ(stopped.status.code(), core::StatusCode::kNotConverged);
+  EXPECT_TRUE(stopped.stats.features_dropped);
+  EXPECT_FALSE(stopped.stats.features_dropped_reason.empty());
 
   const FeatureRun run = run_with_features(mesh, kPlateTarget, false);
   ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();

@@ -64,6 +64,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   quantize::QuantizeOptions quantize_options;
   quantize_options.target_faces = args.target_faces;
   quantize_options.edge_length = args.edge_length;
+  // A dead end with the features stops the quantization: the map is parametrized again without
+  // them (below) rather than quantized as it is.
+  quantize_options.quantize_without_features = false;
   quantize_options.threads = common.threads;
   quantize_options.progress = on_progress;
   quantize_options.time_budget_seconds = args.time_budget;
@@ -113,7 +116,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
   bool features_dropped = false;
   std::string features_dropped_reason;
-  if (integer_map.status.is_ok() && integer_map.stats.features_dropped) {
+  if (integer_map.stats.features_dropped &&
+      (integer_map.status.is_ok() || integer_map.status.code() == core::StatusCode::kNotConverged)) {
     features_dropped = true;
     features_dropped_reason = integer_map.stats.features_dropped_reason;
     if (!common.quiet)

@@ -43,6 +43,11 @@ struct QuantizeOptions {
   // releases in one run the next attempt starts (features rounded last, then none). 0: any dead
   // end drops to the next attempt.
   int feature_release_rounds = 32;
+  // When the rounding with the aligned features dead-ends: true, quantize the same map without
+  // them (at every scale); false, stop there with status kNotConverged and stats.features_dropped
+  // set, for a caller that parametrizes again without the features (the map they shaped has
+  // more cones and distortion; the remesher does this).
+  bool quantize_without_features = true;
   // Allowed seam residual of the input |e_b − R^r e_a|, × its UV bounding-box diagonal.
   double input_seam_tol = 1e-6;
   // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
