@@ -151,7 +151,12 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   if (!extracted.status.is_ok())
     throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
   int refinements = 0;
-  for (; refinements < kMaxRefinements && !quadex::compute_quad_metrics(extracted.quads).manifold;
+  // Only an input that was manifold before the repair must give manifold quads (the places
+  // where the repair split a non-manifold edge or vertex are kept as they are).
+  const bool manifold_input = loaded.repaired.report.nonmanifold_edges_split == 0 &&
+                              loaded.repaired.report.nonmanifold_vertices_split == 0;
+  for (; refinements < kMaxRefinements && manifold_input &&
+         !quadex::compute_quad_metrics(extracted.quads).manifold;
        ++refinements) {
     const int faces_before = extracted.stats.n_faces;
     refine_density(mesh, &quantize_options);
