@@ -564,6 +564,22 @@ struct PinnedLayout::Impl {
     return true;
   }
 
+  // Linear response to the displacement v of the non-free variables (zero elsewhere): one Newton
+  // solve at x with v prescribed, the free variables following by the Hessian. *dx = P·dy in the
+  // internal full order; false when the factorization fails.
+  bool prescribed_response(const Eigen::VectorXd& v, Eigen::VectorXd* dx) {
+    Eigen::VectorXd g, Hv, dy;
+    evaluate(x, true, &g, &v, &Hv);
+    Eigen::VectorXd rhs = -Hv;
+    for (int i = 0; i < n(); ++i)
+      if (state[i] != 0) rhs[i] = v[i];
+    if (!solve(rhs, &dy)) return false;
+    for (int i = 0; i < n(); ++i)
+      if (state[i] != 0) dy[i] = v[i];
+    *dx = red.P * dy;
+    return true;
+  }
+
   double max_step(const Eigen::VectorXd& xx, const Eigen::VectorXd& dx) const {
     double t = std::numeric_limits<double>::infinity();
     for (int f = 0; f < domain.n_faces(); ++f) {
@@ -865,17 +881,10 @@ std::vector<int> PinnedLayout::limiting_faces(const std::vector<std::pair<int, d
   }
   std::vector<int> out;
   if (prescribed.empty()) return out;
-  Eigen::VectorXd g, Hv, dy;
-  m.evaluate(m.x, true, &g, &v, &Hv);
-  Eigen::VectorXd rhs = -Hv;
-  for (int i = 0; i < m.n(); ++i)
-    if (m.state[i] != 0) rhs[i] = v[i];
-  const bool solved = m.solve(rhs, &dy);
+  Eigen::VectorXd dx;
+  const bool solved = m.prescribed_response(v, &dx);
   for (const int j : prescribed) m.state[j] = 0;
   if (!solved) return out;
-  for (int i = 0; i < m.n(); ++i)
-    if (m.state[i] != 0) dy[i] = v[i];
-  const Eigen::VectorXd dx = m.red.P * dy;
   for (int f = 0; f < m.domain.n_faces(); ++f)
     if (flip_root(m.edge_matrix(m.x, f), m.edge_matrix(dx, f)) <= 1) out.push_back(f);
   return out;
@@ -929,7 +938,7 @@ PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
   // growing, where the barrier bends the layout out of the way instead of the linear response
   // crushing it. A target that the barrier holds back (its residual stops shrinking) blocks.
   if (settings.penalty_stages > 0) {
-    Eigen::VectorXd g0, Hv0, v0 = Eigen::VectorXd::Zero(m.n()), dy0;
+    Eigen::VectorXd v0 = Eigen::VectorXd::Zero(m.n());
     double v_max = 0;
     for (size_t i = 0; i < nt; ++i)
       if (active[i]) {
@@ -937,17 +946,9 @@ PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
         v_max = std::max(v_max, std::abs(v0[targets[i].first]));
       }
     bool reaches = v_max == 0;
-    if (!reaches) {
-      m.evaluate(m.x, true, &g0, &v0, &Hv0);
-      Eigen::VectorXd rhs = -Hv0;
-      for (int i = 0; i < m.n(); ++i)
-        if (m.state[i] != 0) rhs[i] = v0[i];
-      if (m.solve(rhs, &dy0)) {
-        for (int i = 0; i < m.n(); ++i)
-          if (m.state[i] != 0) dy0[i] = v0[i];
-        reaches = kPinStepFraction * m.max_step(m.x, m.red.P * dy0) >= 1;
-      }
-    }
+    Eigen::VectorXd dx0;
+    if (!reaches && m.prescribed_response(v0, &dx0))
+      reaches = kPinStepFraction * m.max_step(m.x, dx0) >= 1;
     if (!reaches) {
       double mean_area = 0, mean_edge_sq = 0;
       for (int f = 0; f < m.domain.n_faces(); ++f) {

@@ -108,10 +108,14 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
       throw CliError{kExitInternal, args.input + ": seamless parametrization failed: " + result.status.to_string()};
     return result;
   };
+  auto quantize_map = [&](const param::ParamResult& map) {
+    progress.begin("quantize");
+    quantize::QuantizeResult result = quantize::quantize_seamless(mesh, map, quantize_options);
+    progress.end();
+    return result;
+  };
   param::ParamResult seamless = parametrize(param_options);
-  progress.begin("quantize");
-  quantize::QuantizeResult integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
-  progress.end();
+  quantize::QuantizeResult integer_map = quantize_map(seamless);
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
   bool features_dropped = false;
@@ -127,9 +131,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     param_options.feature_edges.clear();
     param_options.align_boundaries = false;
     seamless = parametrize(param_options);
-    progress.begin("quantize");
-    integer_map = quantize::quantize_seamless(mesh, seamless, quantize_options);
-    progress.end();
+    integer_map = quantize_map(seamless);
   }
   if (integer_map.status.is_ok() && integer_map.stats.n_released_feature_edges > 0 && !common.quiet)
     std::fprintf(stderr,
@@ -145,9 +147,13 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
 
   quadex::ExtractOptions extract_options;
   extract_options.output_uv = args.keep_uv;
-  progress.begin("extract");
-  quadex::ExtractResult extracted = quadex::extract_quads(integer_map.uv, extract_options);
-  progress.end();
+  auto extract = [&](const quantize::QuantizeResult& map) {
+    progress.begin("extract");
+    quadex::ExtractResult result = quadex::extract_quads(map.uv, extract_options);
+    progress.end();
+    return result;
+  };
+  quadex::ExtractResult extracted = extract(integer_map);
   if (!extracted.status.is_ok())
     throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
   int refinements = 0;
@@ -160,13 +166,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
        ++refinements) {
     const int faces_before = extracted.stats.n_faces;
     refine_density(mesh, &quantize_options);
-    progress.begin("quantize");
-    quantize::QuantizeResult finer = quantize::quantize_seamless(mesh, seamless, quantize_options);
-    progress.end();
+    quantize::QuantizeResult finer = quantize_map(seamless);
     if (!finer.status.is_ok()) break;
-    progress.begin("extract");
-    quadex::ExtractResult finer_quads = quadex::extract_quads(finer.uv, extract_options);
-    progress.end();
+    quadex::ExtractResult finer_quads = extract(finer);
     if (!finer_quads.status.is_ok()) break;
     if (!common.quiet)
       std::fprintf(stderr,
