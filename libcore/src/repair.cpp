@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <numbers>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,16 @@ namespace quadify::core {
 namespace {
 
 using Tri = std::array<int, 3>;
+
+// Caps with an angle of at least this (degrees) but below RepairOptions::cap_angle_deg are removed
+// where the neighbour across their long edge is flat with them: the cap's vertex within
+// kFlatCapTolerance of the long edge's length of the neighbour's plane. The flip only
+// re-triangulates a flat quad, and a wedge between two feature edges (a curve's vertex whose
+// triangle spans the chord) gets a second corner, which seamless maps need to keep it straight.
+constexpr double kFlatCapAngleDeg = 150;
+constexpr double kFlatCapTolerance = 0.01;
+// ... and only between two creases: both short edges' dihedral angles at least this (degrees).
+constexpr double kFlatCapCreaseDeg = 30;
 
 struct DisjointSets {
   std::vector<int> parent;
@@ -169,6 +180,7 @@ class Repairer {
         return result;
       }
     }
+    if (opt_.orient_components) flip_folds(&rep);
     remove_unreferenced(&rep, &result);
     try {
       const EdgeTopology topo = build_edge_topology(result.mesh);
@@ -226,9 +238,27 @@ class Repairer {
     return 0.5 * (b - a).cross(c - a).norm() < opt_.degenerate_area_tolerance * diag_ * diag_;
   }
 
-  // Removes each zero-area triangle (a, m, b), m opposite its longest edge (a, b), by splitting
-  // the neighbour across (a, b) at m: the neighbour's edge a-b becomes a-m-b, which matches the
-  // two short edges of the removed triangle, so a closed surface stays closed.
+  // The largest angle of a triangle (radians).
+  double max_angle(const Tri& t) const {
+    double best = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = V_.row(t[k]);
+      const Eigen::Vector3d u = Eigen::Vector3d(V_.row(t[(k + 1) % 3])) - p;
+      const Eigen::Vector3d w = Eigen::Vector3d(V_.row(t[(k + 2) % 3])) - p;
+      best = std::max(best, std::atan2(u.cross(w).norm(), u.dot(w)));
+    }
+    return best;
+  }
+  // A cap to remove: an angle of at least cap_angle_deg, or of at least kFlatCapAngle when the
+  // neighbour across the long edge is flat with it (checked at the removal).
+  bool is_cap(const Tri& t) const {
+    return opt_.cap_angle_deg < 180 &&
+           max_angle(t) >= std::min(opt_.cap_angle_deg, kFlatCapAngleDeg) * (std::numbers::pi / 180);
+  }
+
+  // Removes each zero-area triangle and each cap (a, m, b), m opposite its longest edge (a, b),
+  // by splitting the neighbour across (a, b) at m: the neighbour's edge a-b becomes a-m-b, which
+  // matches the two short edges of the removed triangle, so a closed surface stays closed.
   void remove_zero_area(RepairReport* rep) {
     std::unordered_map<long long, std::vector<int>> edge_faces;
     auto link = [&](int f) {
@@ -240,9 +270,10 @@ class Repairer {
         list.erase(std::find(list.begin(), list.end(), f));
       }
     };
+    auto degenerate = [&](const Tri& t) { return is_zero_area(t) || is_cap(t); };
     std::deque<int> queue;
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
-      if (alive_[f] && is_zero_area(tris_[f])) queue.push_back(f);
+      if (alive_[f] && degenerate(tris_[f])) queue.push_back(f);
     if (queue.empty()) return;
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
       if (alive_[f]) link(f);
@@ -251,7 +282,9 @@ class Repairer {
     while (!queue.empty()) {
       const int f = queue.front();
       queue.pop_front();
-      if (!alive_[f] || !is_zero_area(tris_[f])) continue;
+      if (!alive_[f]) continue;
+      const bool zero = is_zero_area(tris_[f]);
+      if (!zero && !is_cap(tris_[f])) continue;
       const Tri t = tris_[f];
       int k_long = 0;  // longest edge runs t[k_long] → t[k_long+1]
       double best = -1.0;
@@ -260,16 +293,49 @@ class Repairer {
         if (len > best) best = len, k_long = k;
       }
       const int a = t[k_long], b = t[(k_long + 1) % 3], m = t[(k_long + 2) % 3];
+      const auto& across = edge_faces[edge_key(a, b)];
+      // A cap is only removed by a split that keeps the surface as it is: one neighbour, whose
+      // third vertex is not joined to m yet.
+      int g = -1, c = -1;
+      if (across.size() == 2) {
+        g = across[0] == f ? across[1] : across[0];
+        const Tri& u = tris_[g];
+        for (int v : u)
+          if (v != a && v != b) c = v;
+      }
+      if (!zero && (g < 0 || c == m || !edge_faces[edge_key(m, c)].empty())) continue;
+      if (!zero) {
+        // The two new triangles must face like the neighbour they replace; below cap_angle_deg
+        // the cap's vertex must also lie in the neighbour's plane (the surface stays as it is).
+        const Eigen::Vector3d pa = V_.row(a), pb = V_.row(b), pc = V_.row(c), pm = V_.row(m);
+        const Eigen::Vector3d n = (pb - pa).cross(pc - pa);
+        if (n.dot((pm - pa).cross(pc - pa)) <= 0 || n.dot((pb - pm).cross(pc - pm)) <= 0) continue;
+        // Each removal lowers the largest angle where it acts, so removals cannot cycle.
+        if (std::max(max_angle({a, m, c}), max_angle({m, b, c})) >= max_angle(t)) continue;
+        const bool sharp_cap = max_angle(t) >= opt_.cap_angle_deg * (std::numbers::pi / 180);
+        if (!sharp_cap && std::abs(n.normalized().dot(pm - pa)) > kFlatCapTolerance * (pb - pa).norm())
+          continue;
+        // Below cap_angle_deg only the caps between two creases: a curve's vertex m whose one
+        // triangle spans the chord a-b (elsewhere the flip would only perturb the tessellation).
+        if (!sharp_cap) {
+          const Eigen::Vector3d nt = (pm - pa).cross(pb - pa).normalized();
+          auto crease = [&](int p, int q) {
+            for (const int h : edge_faces[edge_key(p, q)])
+              if (h != f && std::abs(normal(tris_[h]).normalized().dot(nt)) < std::cos(kFlatCapCreaseDeg * std::numbers::pi / 180))
+                return true;
+            return false;
+          };
+          if (!crease(a, m) || !crease(m, b)) continue;
+        }
+      }
       unlink(f);
       alive_[f] = 0;
-      ++rep->degenerate_faces_removed;
-      const auto& across = edge_faces[edge_key(a, b)];
-      if (across.size() != 1 || --budget < 0) continue;  // boundary or non-manifold: just drop
-      const int g = across.front();
+      ++(zero ? rep->degenerate_faces_removed : rep->caps_removed);
+      if (g < 0 || --budget < 0) continue;  // boundary or non-manifold: just drop
       const Tri u = tris_[g];
       int j = 0;
       while (!((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))) ++j;
-      const int x = u[j], y = u[(j + 1) % 3], c = u[(j + 2) % 3];
+      const int x = u[j], y = u[(j + 1) % 3];
       if (c == m) {  // the neighbour is the same triangle reversed: both vanish
         unlink(g);
         alive_[g] = 0;
@@ -282,8 +348,77 @@ class Repairer {
         tris_.push_back(n);
         alive_.push_back(1);
         link(static_cast<int>(tris_.size()) - 1);
-        if (is_zero_area(n)) queue.push_back(static_cast<int>(tris_.size()) - 1);
+        if (degenerate(n)) queue.push_back(static_cast<int>(tris_.size()) - 1);
       }
+    }
+  }
+
+  Eigen::Vector3d normal(const Tri& t) const {
+    const Eigen::Vector3d a = V_.row(t[0]), b = V_.row(t[1]), c = V_.row(t[2]);
+    return (b - a).cross(c - a);
+  }
+
+  // Flips the edges of folded triangle pairs (see RepairOptions::fold_angle_deg). Runs on the
+  // oriented, edge-manifold triangles.
+  void flip_folds(RepairReport* rep) {
+    if (!(opt_.fold_angle_deg < 180)) return;
+    constexpr double kPlaneTolerance = 0.02;       // relative to the edge length
+    const double kAgree = std::cos(std::numbers::pi / 6);  // new pair's normals within 30°
+    const double fold_cos = std::cos(opt_.fold_angle_deg * (std::numbers::pi / 180));
+    std::unordered_map<long long, std::vector<int>> edge_faces;
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+      for (int k = 0; k < 3; ++k) edge_faces[edge_key(tris_[f][k], tris_[f][(k + 1) % 3])].push_back(f);
+    std::deque<long long> queue;
+    for (const auto& [key, faces] : edge_faces)
+      if (faces.size() == 2) queue.push_back(key);
+    std::sort(queue.begin(), queue.end());  // deterministic order
+    long long budget = static_cast<long long>(tris_.size()) + 16;
+    auto plane_distance = [&](const Tri& t, int v) {
+      const Eigen::Vector3d n = normal(t).normalized();
+      return std::abs(n.dot(Eigen::Vector3d(V_.row(v)) - Eigen::Vector3d(V_.row(t[0]))));
+    };
+    while (!queue.empty() && budget > 0) {
+      const long long key = queue.front();
+      queue.pop_front();
+      const auto it = edge_faces.find(key);
+      if (it == edge_faces.end() || it->second.size() != 2) continue;
+      const int f = it->second[0], g = it->second[1];
+      const Eigen::Vector3d nf = normal(tris_[f]), ng = normal(tris_[g]);
+      if (nf.norm() == 0 || ng.norm() == 0 || nf.normalized().dot(ng.normalized()) > fold_cos) continue;
+      // f = (a, b, c), g = (b, a, d).
+      int k = 0;
+      while (edge_key(tris_[f][k], tris_[f][(k + 1) % 3]) != key) ++k;
+      const int a = tris_[f][k], b = tris_[f][(k + 1) % 3], c = tris_[f][(k + 2) % 3];
+      int d = -1;
+      for (int j = 0; j < 3; ++j)
+        if (tris_[g][j] == b && tris_[g][(j + 1) % 3] == a) d = tris_[g][(j + 2) % 3];
+      if (d < 0 || d == c || edge_faces.count(edge_key(c, d))) continue;
+      const double len = (V_.row(a) - V_.row(b)).norm();
+      // One of them is usually a sliver with a noisy normal: its far vertex is in the other's plane.
+      if (std::min(plane_distance(tris_[f], d), plane_distance(tris_[g], c)) > kPlaneTolerance * len)
+        continue;
+      const Tri t1{a, d, c}, t2{d, b, c};
+      const Eigen::Vector3d n1 = normal(t1), n2 = normal(t2);
+      if (n1.norm() == 0 || n2.norm() == 0 || n1.normalized().dot(n2.normalized()) < kAgree) continue;
+      --budget;
+      auto unlink = [&](int face) {
+        for (int j = 0; j < 3; ++j) {
+          auto& list = edge_faces[edge_key(tris_[face][j], tris_[face][(j + 1) % 3])];
+          list.erase(std::find(list.begin(), list.end(), face));
+        }
+      };
+      unlink(f);
+      unlink(g);
+      edge_faces.erase(key);
+      tris_[f] = t1;
+      tris_[g] = t2;
+      for (const int face : {f, g})
+        for (int j = 0; j < 3; ++j) {
+          const long long e = edge_key(tris_[face][j], tris_[face][(j + 1) % 3]);
+          edge_faces[e].push_back(face);
+          queue.push_back(e);
+        }
+      ++rep->folds_flipped;
     }
   }
 
@@ -500,7 +635,7 @@ class Repairer {
 
 bool RepairReport::changed() const {
   return polygons_triangulated || invalid_faces_removed || welded_vertices ||
-         degenerate_faces_removed || duplicate_faces_removed || unreferenced_vertices_removed ||
+         degenerate_faces_removed || caps_removed || folds_flipped || duplicate_faces_removed || unreferenced_vertices_removed ||
          faces_reoriented || nonmanifold_edges_split || nonmanifold_vertices_split;
 }
 

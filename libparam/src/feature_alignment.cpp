@@ -15,6 +15,13 @@ constexpr int kRotationIterations = 20;
 // Two features at a vertex whose target directions are closer than this (radians) would be laid
 // along one direction: their wedge closes.
 constexpr double kMinWedge = std::numbers::pi / 4;
+// A feature in a wedge conflict is given its other axis only if that turns it by at most this
+// (radians; 3/4 of a quarter turn): a feature near 45° (local estimation's coin toss) switches,
+// one clearly on its axis is disabled instead.
+// Two features at a vertex whose surface angle is within this of 180° (radians) continue one
+// curve.
+constexpr double kStraightContinuation = std::numbers::pi / 6;
+constexpr double kMaxRelabelTurn = 0.6 * std::numbers::pi / 2;
 
 int next_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 1) % 3; }
 int prev_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 2) % 3; }
@@ -99,10 +106,11 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
   return std::atan2(center[largest].y(), center[largest].x());
 }
 
-std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
-                                 const Eigen::VectorXd& x, const FeatureSet& fs,
-                                 const std::vector<int>& label, const std::vector<char>& is_new,
-                                 double max_ratio, double max_boundary_ratio) {
+WedgeResolution resolve_wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
+                                        const Eigen::VectorXd& x, const FeatureSet& fs,
+                                        const std::vector<int>& label,
+                                        const std::vector<char>& is_new, double max_ratio,
+                                        double max_boundary_ratio) {
   const auto& topo = cut.topo;
   const int nv = mesh.n_vertices();
   std::vector<char> check(nv, 0);
@@ -119,17 +127,21 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
     if (check[v] && (start[v] < 0 || topo.twin[c] < 0)) start[v] = c;
   }
   std::vector<int> lab = label;
-  std::vector<double> delta(fs.size(), 0);
-  // The turn that brings each labeled feature onto its axis: to the nearest quarter of its
-  // label's parity (local estimation may have chosen the farther axis).
-  for (int i = 0; i < fs.size(); ++i) {
-    const double q = feature_measure(cut, x, fs.halfedge[i]);
+  std::vector<double> measure(fs.size(), 0), delta(fs.size(), 0);
+  // The turn that brings a labeled feature onto its axis: to the nearest quarter of its label's
+  // parity (local estimation may have chosen the farther axis).
+  auto turn = [&](int i, int l) {
+    const double q = measure[i];
     double target = std::round(q);
-    if ((label[i] == 0 || label[i] == 1) && nearest_label(q) != label[i])
-      target += q < target ? -1 : 1;
-    delta[i] = (target - q) * (std::numbers::pi / 2);
+    if ((l == 0 || l == 1) && nearest_label(q) != l) target += q < target ? -1 : 1;
+    return (target - q) * (std::numbers::pi / 2);
+  };
+  for (int i = 0; i < fs.size(); ++i) {
+    measure[i] = feature_measure(cut, x, fs.halfedge[i]);
+    delta[i] = turn(i, label[i]);
   }
-  std::vector<int> disabled;
+  WedgeResolution out;
+  std::vector<char> tried(fs.size(), 0);  // given the other axis once already
   struct Entry {
     double angle;    // unwrapped, from the fan's first outgoing edge
     double angle3d;  // the same on the surface
@@ -143,6 +155,13 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
     const Eigen::Vector3d b = Eigen::Vector3d(mesh.V.row(mesh.F(c / 3, (c % 3 + 2) % 3))) - p;
     return std::atan2(a.cross(b).norm(), a.dot(b));
   };
+  struct Fan {
+    int v;
+    std::vector<Entry> entries;
+    double total = 0, total3d = 0;
+    bool closed = false;
+  };
+  std::vector<Fan> fans;
   for (int v = 0; v < nv; ++v) {
     if (start[v] < 0) continue;
     std::vector<Entry> fan;
@@ -168,49 +187,75 @@ std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
       c = next;
     }
     if (!closed && !fan.empty()) fan.front().boundary = true;
-    for (bool changed = true; changed;) {
-      changed = false;
-      std::vector<Entry> on;
-      for (size_t i = 0; i < fan.size(); ++i)
-        if (fan[i].feature >= 0 && (lab[fan[i].feature] == 0 || lab[fan[i].feature] == 1)) {
-          on.push_back(fan[i]);
-          on.back().corner = static_cast<int>(i);
+    fans.push_back({v, std::move(fan), total, total3d, closed});
+  }
+  // A victim of a conflict first gets the other axis (when that turns it by at most
+  // kMaxRelabelTurn), then is disabled if it still conflicts; every fan is checked again until
+  // none changes (each feature changes at most twice).
+  for (bool any = true; any;) {
+    any = false;
+    for (const Fan& fn : fans) {
+      const std::vector<Entry>& fan = fn.entries;
+      const double total = fn.total, total3d = fn.total3d;
+      const bool closed = fn.closed;
+      for (bool changed = true; changed;) {
+        changed = false;
+        std::vector<Entry> on;
+        for (size_t i = 0; i < fan.size(); ++i)
+          if (fan[i].feature >= 0 && (lab[fan[i].feature] == 0 || lab[fan[i].feature] == 1)) {
+            on.push_back(fan[i]);
+            on.back().corner = static_cast<int>(i);
+          }
+        if (on.size() < 2) break;
+        const size_t n_pairs = closed ? on.size() : on.size() - 1;
+        const int n_corners = static_cast<int>(closed ? fan.size() : fan.size() - 1);
+        for (size_t j = 0; j < n_pairs && !changed; ++j) {
+          const Entry& a = on[j];
+          const Entry& b = on[(j + 1) % on.size()];
+          const double target_a = a.angle + delta[a.feature];
+          const bool wraps = j + 1 == on.size();
+          const double target_b = b.angle + (wraps ? total : 0) + delta[b.feature];
+          const double gap = target_b - target_a;
+          const double quarters = std::max(1.0, std::round(gap / (std::numbers::pi / 2)));
+          const double gap3d = b.angle3d + (wraps ? total3d : 0) - a.angle3d;
+          const double ratio = std::max(quarters * (std::numbers::pi / 2) / gap3d,
+                                        gap3d / (quarters * (std::numbers::pi / 2)));
+          // Each triangle corner of the wedge opens less than 180°.
+          const int corners = b.corner + (wraps ? n_corners : 0) - a.corner;
+          const double bound = a.boundary || b.boundary ? max_boundary_ratio : max_ratio;
+          if (gap >= kMinWedge && ratio <= bound && quarters < 2 * corners) continue;
+          int victim = -1;
+          if (is_new[a.feature] && is_new[b.feature])
+            victim = std::abs(delta[a.feature]) >= std::abs(delta[b.feature]) ? a.feature : b.feature;
+          else if (is_new[a.feature])
+            victim = a.feature;
+          else if (is_new[b.feature])
+            victim = b.feature;
+          if (victim < 0 || a.feature == b.feature) continue;
+          changed = any = true;
+          // Where a curve continues almost straight, a conflict is where its label must switch
+          // (a smooth curve turning past 45°): relabeling would only move the switch along it.
+          const bool straight = std::abs(gap3d - std::numbers::pi) < kStraightContinuation;
+          if (!tried[victim] && !straight) {
+            tried[victim] = 1;
+            const double other = turn(victim, 1 - lab[victim]);
+            if (std::abs(other) <= kMaxRelabelTurn) {
+              lab[victim] = 1 - lab[victim];
+              delta[victim] = other;
+              continue;
+            }
+          }
+          lab[victim] = kDisabled;
+          out.disabled.push_back(victim);
         }
-      if (on.size() < 2) break;
-      const size_t n_pairs = closed ? on.size() : on.size() - 1;
-      const int n_corners = static_cast<int>(closed ? fan.size() : fan.size() - 1);
-      for (size_t j = 0; j < n_pairs && !changed; ++j) {
-        const Entry& a = on[j];
-        const Entry& b = on[(j + 1) % on.size()];
-        const double target_a = a.angle + delta[a.feature];
-        const bool wraps = j + 1 == on.size();
-        const double target_b = b.angle + (wraps ? total : 0) + delta[b.feature];
-        const double gap = target_b - target_a;
-        const double quarters = std::max(1.0, std::round(gap / (std::numbers::pi / 2)));
-        const double gap3d = b.angle3d + (wraps ? total3d : 0) - a.angle3d;
-        const double ratio = std::max(quarters * (std::numbers::pi / 2) / gap3d,
-                                      gap3d / (quarters * (std::numbers::pi / 2)));
-        // Each triangle corner of the wedge opens less than 180°.
-        const int corners = b.corner + (wraps ? n_corners : 0) - a.corner;
-        const double bound = a.boundary || b.boundary ? max_boundary_ratio : max_ratio;
-        if (gap >= kMinWedge && ratio <= bound && quarters < 2 * corners) continue;
-        int victim = -1;
-        if (is_new[a.feature] && is_new[b.feature])
-          victim = std::abs(delta[a.feature]) >= std::abs(delta[b.feature]) ? a.feature : b.feature;
-        else if (is_new[a.feature])
-          victim = a.feature;
-        else if (is_new[b.feature])
-          victim = b.feature;
-        if (victim < 0 || a.feature == b.feature) continue;
-        lab[victim] = kDisabled;
-        disabled.push_back(victim);
-        changed = true;
       }
     }
   }
-  std::sort(disabled.begin(), disabled.end());
-  disabled.erase(std::unique(disabled.begin(), disabled.end()), disabled.end());
-  return disabled;
+  std::sort(out.disabled.begin(), out.disabled.end());
+  out.disabled.erase(std::unique(out.disabled.begin(), out.disabled.end()), out.disabled.end());
+  for (int i = 0; i < fs.size(); ++i)
+    if (tried[i] && lab[i] != label[i] && (lab[i] == 0 || lab[i] == 1)) out.relabeled.push_back(i);
+  return out;
 }
 
 }  // namespace quadify::param

@@ -47,15 +47,22 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 // Wedge check around every vertex touched by a feature of `is_new`: going around the vertex
 // through its faces in the layout x, each labeled feature edge (label 0/1, old or new) will turn
 // by its rounding δ to its axis; two consecutive ones whose target directions are less than
-// 45° apart would close the faces between them (both along one direction). Returns the new
-// features to disable, one per such pair (the one farther from its axis), until no pair remains.
+// 45° apart would close the faces between them (both along one direction). One feature of each
+// such pair (a new one, the one farther from its axis) is first given its other axis, if that
+// turns it by less than 3/4 of a quarter turn; if it still conflicts, it is disabled; until no
+// pair remains.
 // A pair whose wedge would open or close by more than max_ratio (its target angle, a multiple of
 // 90°, against its angle on the surface) is a conflict too: it would cost a distortion of about
 // that ratio. A wedge bounded by a boundary edge (where an open mesh needs its corners) uses
 // max_boundary_ratio instead.
-std::vector<int> wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
-                                 const Eigen::VectorXd& x, const FeatureSet& fs,
-                                 const std::vector<int>& label, const std::vector<char>& is_new,
-                                 double max_ratio, double max_boundary_ratio);
+struct WedgeResolution {
+  std::vector<int> relabeled;  // new features to give the other axis (increasing)
+  std::vector<int> disabled;   // new features to disable (increasing)
+};
+WedgeResolution resolve_wedge_conflicts(const core::TriMesh& mesh, const CutMesh& cut,
+                                        const Eigen::VectorXd& x, const FeatureSet& fs,
+                                        const std::vector<int>& label,
+                                        const std::vector<char>& is_new, double max_ratio,
+                                        double max_boundary_ratio);
 
 }  // namespace quadify::param

@@ -56,7 +56,7 @@ std::vector<int> LocalEstimator::patch_faces_around(int v0, int v1) const {
 
 LocalEstimator::Alternatives LocalEstimator::evaluate(
     int v0, int v1, int skip_seam, int skip_feature,
-    const std::array<std::vector<SparseRow>, 2>& alternative, double edge_length,
+    const std::array<std::vector<SparseRow>, 2>& alternative, bool free_layout, double edge_length,
     const std::vector<int>& rounded, const std::vector<int>& labels, const Eigen::VectorXd& x,
     Density density, double power) const {
   Alternatives out{};
@@ -115,6 +115,29 @@ LocalEstimator::Alternatives LocalEstimator::evaluate(
       }
     }
   const Reduction base_red = base.reduction(x0);
+  // Optimizes the patch from xs in `red`; its energy and τ (+inf when it failed or flipped).
+  auto lay_out = [&](const Reduction& red, const Eigen::VectorXd& xs, double* value, double* tau) {
+    *value = *tau = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd y = red.restrict(xs);
+    OptimizeSettings st;
+    st.density = density;
+    st.power = power;
+    st.max_iterations = kPatchIterations;
+    st.relative_tolerance = kPatchTolerance;
+    const OptimizeReport rep = optimize_layout(dom, red, st, &y);
+    if (!rep.status.is_ok()) return;
+    *value = rep.energy;
+    const Eigen::VectorXd xl = red.expand(y);
+    double s1max = 0, s2min = std::numeric_limits<double>::infinity();
+    for (int f = 0; f < dom.n_faces(); ++f) {
+      const Eigen::Matrix2d J = face_jacobian(dom, f, xl);
+      const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
+      const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
+      s1max = std::max(s1max, 0.5 * (ps + pa));
+      s2min = std::min(s2min, 0.5 * (ps - pa));
+    }
+    if (s2min > 0) *tau = std::sqrt(s1max / s2min);
+  };
   for (int side = 0; side < 2; ++side) {
     ConstraintEliminator elim = base;
     std::vector<SparseRow> rows;
@@ -125,32 +148,13 @@ LocalEstimator::Alternatives LocalEstimator::evaluate(
     Eigen::VectorXd xs = x0;
     TransitionReport tr =
         move_into_constraints(dom, base_red, elim, rows, area / (edge_length * edge_length), &xs);
-    double value = std::numeric_limits<double>::infinity();
-    double tau = std::numeric_limits<double>::infinity();
-    if (tr.status.is_ok()) {
-      Eigen::VectorXd y = tr.reduction.restrict(xs);
-      OptimizeSettings st;
-      st.density = density;
-      st.power = power;
-      st.max_iterations = kPatchIterations;
-      st.relative_tolerance = kPatchTolerance;
-      const OptimizeReport rep = optimize_layout(dom, tr.reduction, st, &y);
-      if (rep.status.is_ok()) {
-        value = rep.energy;
-        const Eigen::VectorXd xl = tr.reduction.expand(y);
-        double s1max = 0, s2min = std::numeric_limits<double>::infinity();
-        for (int f = 0; f < dom.n_faces(); ++f) {
-          const Eigen::Matrix2d J = face_jacobian(dom, f, xl);
-          const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
-          const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
-          s1max = std::max(s1max, 0.5 * (ps + pa));
-          s2min = std::min(s2min, 0.5 * (ps - pa));
-        }
-        if (s2min > 0) tau = std::sqrt(s1max / s2min);
-      }
-    }
-    out.energy[side] = value;
-    out.tau[side] = tau;
+    out.energy[side] = out.tau[side] = std::numeric_limits<double>::infinity();
+    if (tr.status.is_ok()) lay_out(tr.reduction, xs, &out.energy[side], &out.tau[side]);
+  }
+  out.tau_free = std::numeric_limits<double>::infinity();
+  if (free_layout) {
+    double value;
+    lay_out(base_red, x0, &value, &out.tau_free);
   }
   return out;
 }
@@ -165,7 +169,7 @@ PatchChoice LocalEstimator::choose(int seam, double measure, const std::vector<i
     for (const auto& row : seam_constraint_rows(cut_, seam, lo + side)) alt[side].push_back(row);
   const int fa = cut_.seams[seam].he_a / 3, ka = cut_.seams[seam].he_a % 3;
   const Alternatives a = evaluate(mesh_.F(fa, ka), mesh_.F(fa, (ka + 1) % 3), seam, -1, alt,
-                                  seam_length(cut_, seam), rounded, labels, x, density, power);
+                                  false, seam_length(cut_, seam), rounded, labels, x, density, power);
   choice.n_faces = a.n_faces;
   choice.distortion[0] = a.energy[0];
   choice.distortion[1] = a.energy[1];
@@ -191,8 +195,9 @@ FeatureChoice LocalEstimator::choose_feature(int feature, const std::vector<int>
   const int v0 = mesh_.F(h / 3, h % 3), v1 = mesh_.F(h / 3, (h % 3 + 1) % 3);
   const double len = (mesh_.V.row(v1) - mesh_.V.row(v0)).norm();
   const Alternatives a =
-      evaluate(v0, v1, -1, feature, alt, len, rounded, labels, x, density, power);
+      evaluate(v0, v1, -1, feature, alt, true, len, rounded, labels, x, density, power);
   choice.n_faces = a.n_faces;
+  choice.tau_free = a.tau_free;
   for (int c = 0; c < 2; ++c) {
     choice.distortion[c] = a.energy[c];
     choice.tau[c] = a.tau[c];

@@ -24,6 +24,8 @@ struct FeatureChoice {
   int label = 0;                    // constant coordinate of the better layout
   double distortion[2] = {0, 0};    // label 0, label 1 (+inf when the layout failed or flipped)
   double tau[2] = {0, 0};           // max distortion τ over the patch of each layout
+  double tau_free = 0;              // τ of the patch laid out without the label (the part of
+                                    // the distortion that the feature is not to blame for)
   int n_faces = 0;
 };
 
@@ -50,12 +52,14 @@ class LocalEstimator {
   struct Alternatives {
     double energy[2];
     double tau[2];
+    double tau_free;  // +inf unless asked for
     int n_faces;
   };
   // Lays out the patch around mesh edge (v0, v1) twice, with the fixed rows inside it (rounded
-  // seams except skip_seam, labeled features except skip_feature) plus alternative[side].
+  // seams except skip_seam, labeled features except skip_feature) plus alternative[side]; with
+  // `free_layout`, a third time with the fixed rows only.
   Alternatives evaluate(int v0, int v1, int skip_seam, int skip_feature,
-                        const std::array<std::vector<SparseRow>, 2>& alternative,
+                        const std::array<std::vector<SparseRow>, 2>& alternative, bool free_layout,
                         double edge_length, const std::vector<int>& rounded,
                         const std::vector<int>& labels, const Eigen::VectorXd& x, Density density,
                         double power) const;

@@ -62,6 +62,9 @@ constexpr int kSoftTightenStages = 4;
 // each but the last.
 constexpr int kSoftFeatureRounds = 2;
 constexpr double kSoftStretchGrowth = 1.25;
+// A feature label whose patch exceeds feature_max_tau is kept when the patch without the label
+// reaches within this factor of it (the distortion comes from elsewhere).
+constexpr double kFeatureBlameGrowth = 1.1;
 
 struct ComponentOutput {
   core::Status status;
@@ -237,7 +240,16 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     for (size_t u = 0; u < uncertain.size(); ++u) {
       const FeatureChoice& fc = choices[u];
       ++out.stats.n_feature_patches;
-      (*proposed)[uncertain[u]] = fc.tau[fc.label] > options.feature_max_tau ? kDisabled : fc.label;
+      // A label is refused when its patch exceeds feature_max_tau and the label is to blame:
+      // the patch without it stays clearly below (distortion from cones or labels around it
+      // that the feature does not change is not a reason to drop it).
+      auto acceptable = [&](int l) {
+        return std::isfinite(fc.tau[l]) &&
+               (fc.tau[l] <= options.feature_max_tau || fc.tau[l] <= kFeatureBlameGrowth * fc.tau_free);
+      };
+      int l = fc.label;
+      if (!acceptable(l) && acceptable(1 - l)) l = 1 - l;
+      (*proposed)[uncertain[u]] = acceptable(l) ? l : kDisabled;
     }
     out.stats.seconds_local_estimation += seconds_since(tl);
   };
@@ -310,9 +322,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       if (!uncertain_features.empty()) {
         estimate_feature_labels(uncertain_features, &proposed);
       }
-      for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
-                                         options.feature_max_wedge_stretch, options.feature_max_tau))
-        proposed[i] = kDisabled;
+      const WedgeResolution wr = resolve_wedge_conflicts(
+          mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
+      for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
+      for (const int i : wr.disabled) proposed[i] = kDisabled;
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
@@ -552,9 +565,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         uncertain_features.push_back(i);
     }
     estimate_feature_labels(uncertain_features, &proposed);
-    for (const int i : wedge_conflicts(mesh, cut, x, fs, proposed, is_new,
-                                       options.feature_max_wedge_stretch, options.feature_max_tau))
-      proposed[i] = kDisabled;
+    const WedgeResolution wr = resolve_wedge_conflicts(
+        mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
+    for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
+    for (const int i : wr.disabled) proposed[i] = kDisabled;
     label = proposed;
     // Features next to a face stretched beyond feature_max_tau by the pull (max(σ1, 1/σ2): labels
     // that the fixed matchings cannot honour without crushing triangles) are disabled, and the

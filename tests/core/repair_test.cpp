@@ -8,6 +8,8 @@
 
 #include "test_util.h"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace quadify::core {
@@ -125,6 +127,111 @@ TEST(Repair, DegenerateCapIsRemovedKeepingTheSurfaceClosed) {
   const RepairResult r = repair_mesh(out);
   expect_closed_genus(r, 1, 0, "cap");
   EXPECT_GE(r.report.degenerate_faces_removed, 1);
+}
+
+// Largest triangle angle of a mesh (degrees) and its total area.
+double largest_angle_deg(const TriMesh& m) {
+  double best = 0;
+  for (int f = 0; f < m.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d p = m.V.row(m.F(f, k));
+      const Eigen::Vector3d u = Eigen::Vector3d(m.V.row(m.F(f, (k + 1) % 3))) - p;
+      const Eigen::Vector3d w = Eigen::Vector3d(m.V.row(m.F(f, (k + 2) % 3))) - p;
+      best = std::max(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180 / 3.14159265358979);
+    }
+  return best;
+}
+Eigen::Vector3d area_vector(const TriMesh& m) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (int f = 0; f < m.n_faces(); ++f)
+    sum += 0.5 * (Eigen::Vector3d(m.V.row(m.F(f, 1))) - Eigen::Vector3d(m.V.row(m.F(f, 0))))
+                     .cross(Eigen::Vector3d(m.V.row(m.F(f, 2))) - Eigen::Vector3d(m.V.row(m.F(f, 0))));
+  return sum;
+}
+
+TEST(Repair, NearlyDegenerateCapIsRemovedKeepingTheSurface) {
+  // As above, but the cap's vertex is 0.002 off the cube edge (angle 179.5°, not zero area).
+  PolyMesh m = cube_tris();
+  const int mid = m.n_vertices();
+  m.V.conservativeResize(mid + 1, 3);
+  m.V.row(mid) << 0, 0.5, 0.002;
+  PolyMesh out;
+  out.V = m.V;
+  for (int f = 0; f < m.n_faces(); ++f) {
+    std::vector<int> t = {m.vertex(f, 0), m.vertex(f, 1), m.vertex(f, 2)};
+    if (t == std::vector<int>{0, 3, 2}) {
+      out.add_face({0, 3, mid});
+      out.add_face({mid, 3, 2});
+    } else {
+      out.add_face(t);
+    }
+  }
+  out.add_face({0, mid, 2});
+  RepairOptions keep;
+  keep.cap_angle_deg = 180;
+  const RepairResult kept = repair_mesh(out, keep);
+  EXPECT_EQ(kept.report.caps_removed, 0);
+  EXPECT_GT(largest_angle_deg(kept.mesh), 179);
+  const RepairResult r = repair_mesh(out);
+  expect_closed_genus(r, 1, 0, "cap");
+  EXPECT_EQ(r.report.caps_removed, 1);
+  EXPECT_EQ(r.report.degenerate_faces_removed, 0);
+  EXPECT_EQ(r.mesh.n_vertices(), 9) << "the cap's vertex stays";
+  EXPECT_LT(largest_angle_deg(r.mesh), 178);
+  EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-3);
+}
+
+// An open patch: the cap (a, b, m) with its vertex m 0.18 off the long edge a-b (160°), the
+// triangle (b, a, c) across that edge, and two triangles joining a, m, b to d. With d lifted, the
+// cap's short edges are creases (m is a vertex of a feature curve a-m-b whose one triangle spans
+// the chord a-b).
+PolyMesh cap_patch(double c_height, double d_height) {
+  return make_poly({{0, 0, 0}, {2, 0, 0}, {1, 0.18, 0}, {1, -1, c_height}, {1, 0.68, d_height}},
+                   {{0, 1, 2}, {1, 0, 3}, {0, 2, 4}, {2, 1, 4}});
+}
+
+TEST(Repair, FlatCapBetweenCreasesIsFlippedOthersAreKept) {
+  const RepairResult flat = repair_mesh(cap_patch(0, 1));
+  ASSERT_TRUE(flat.status.is_ok()) << flat.status.to_string();
+  EXPECT_EQ(flat.report.caps_removed, 1);
+  EXPECT_EQ(flat.mesh.n_faces(), 4);
+  EXPECT_LT(largest_angle_deg(flat.mesh), 150);
+  RepairOptions off;
+  off.cap_angle_deg = 180;
+  EXPECT_NEAR((area_vector(flat.mesh) - area_vector(repair_mesh(cap_patch(0, 1), off).mesh)).norm(), 0, 1e-12)
+      << "a flat re-triangulation keeps the area";
+  // With c lifted by 0.5, the edge a-b is a crease too: flipping it would cut across it.
+  const RepairResult bent = repair_mesh(cap_patch(0.5, 1));
+  ASSERT_TRUE(bent.status.is_ok()) << bent.status.to_string();
+  EXPECT_EQ(bent.report.caps_removed, 0);
+  EXPECT_GT(largest_angle_deg(bent.mesh), 159);
+  // All flat: a 160° triangle is only a tessellation's choice there, left as it is.
+  const RepairResult plain = repair_mesh(cap_patch(0, 0));
+  ASSERT_TRUE(plain.status.is_ok()) << plain.status.to_string();
+  EXPECT_EQ(plain.report.caps_removed, 0);
+}
+
+TEST(Repair, FoldedSliverIsFlippedAway) {
+  // The sliver (b, a, d) lies folded over (a, b, c), face to face: d is inside it. Its angle at d
+  // (147°) is not a cap's; the fold is found by the normals.
+  const PolyMesh fold = make_poly({{0, 0, 0}, {2, 0, 0}, {1, -1, 0}, {1, -0.3, 0}},
+                                  {{0, 1, 2}, {1, 0, 3}});
+  const RepairResult r = repair_mesh(fold);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.report.folds_flipped, 1);
+  EXPECT_EQ(r.report.caps_removed, 0);
+  ASSERT_EQ(r.mesh.n_faces(), 2);
+  for (int f = 0; f < 2; ++f) {
+    const Eigen::Vector3d n = (Eigen::Vector3d(r.mesh.V.row(r.mesh.F(f, 1))) - Eigen::Vector3d(r.mesh.V.row(r.mesh.F(f, 0))))
+                                  .cross(Eigen::Vector3d(r.mesh.V.row(r.mesh.F(f, 2))) - Eigen::Vector3d(r.mesh.V.row(r.mesh.F(f, 0))));
+    EXPECT_LT(n.z(), 0) << "face " << f << " faces like the big triangle";
+  }
+  EXPECT_NEAR(area_vector(r.mesh).z(), area_vector(repair_mesh(fold, [] {
+                                                       RepairOptions o;
+                                                       o.fold_angle_deg = 180;
+                                                       return o;
+                                                     }()).mesh).z(), 1e-12)
+      << "the double-covered part cancels either way";
 }
 
 TEST(Repair, NeedleCollapsesByWelding) {

@@ -12,6 +12,7 @@
 #include <libcore/predicates.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <climits>
@@ -383,11 +384,52 @@ TEST(FeatureAlignment, WedgeCheckUsesTheChosenAxisNotTheNearest) {
   ASSERT_EQ(label[0], label[1]) << "opposite directions share an axis";
   const std::vector<char> is_new = {1, 1};
   constexpr double kMaxStretch = 1.8;
-  EXPECT_TRUE(wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch).empty());
+  const WedgeResolution alike = resolve_wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch);
+  EXPECT_TRUE(alike.disabled.empty());
+  EXPECT_TRUE(alike.relabeled.empty());
   label[1] = 1 - label[1];
-  const std::vector<int> disabled = wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch);
-  ASSERT_EQ(disabled.size(), 1u);
-  EXPECT_EQ(disabled[0], 1) << "the feature off its nearest axis is the one turned farthest";
+  const WedgeResolution r = resolve_wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch);
+  ASSERT_EQ(r.disabled.size(), 1u);
+  EXPECT_EQ(r.disabled[0], 1) << "the feature off its nearest axis is the one turned farthest";
+  EXPECT_TRUE(r.relabeled.empty()) << "a straight continuation is a label switch, not a coin toss";
+}
+
+TEST(FeatureAlignment, WedgeCheckGivesACornerFeatureNear45DegreesItsOtherAxis) {
+  // Two spokes at 90° on the surface, the layout turned so that they lie at 40° and 130° from u.
+  // Labeled by their nearest axes they make a corner; if the second gets the first's axis (a coin
+  // toss of local estimation at 45°), the wedge would open to 180°: it gets the other axis back
+  // rather than being disabled.
+  const core::TriMesh mesh = test::make_disk(4, 12);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  Eigen::VectorXd x = flatten(isometric_unfold(mesh, cut));
+  std::vector<int> spokes(2, -1);
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    for (int k = 0; k < 2; ++k)
+      if (cut.topo.edge_vertex(e, k) == 0) {
+        const int w = cut.topo.edge_vertex(e, 1 - k);
+        if (w == 1) spokes[0] = e;
+        if (w == 1 + 3) spokes[1] = e;  // sector 3 of 12: a quarter turn on
+      }
+  ASSERT_GE(spokes[0], 0);
+  ASSERT_GE(spokes[1], 0);
+  const FeatureSet fs = make_feature_set(cut, spokes);
+  ASSERT_EQ(fs.size(), 2);
+  // Turn the layout so that spoke 0 points at 40° from u.
+  const double q0 = feature_measure(cut, x, fs.halfedge[0]);
+  const double turn = (40.0 / 90.0 - q0) * std::numbers::pi / 2;
+  const Eigen::Matrix2d R = Eigen::Rotation2Dd(turn).toRotationMatrix();
+  for (int c = 0; c < x.size() / 2; ++c) x.segment<2>(2 * c) = R * x.segment<2>(2 * c);
+  std::vector<int> label(2);
+  for (int i = 0; i < 2; ++i) label[i] = nearest_label(feature_measure(cut, x, fs.halfedge[i]));
+  ASSERT_NE(label[0], label[1]) << "perpendicular spokes take different axes";
+  const std::vector<char> is_new = {1, 1};
+  constexpr double kMaxStretch = 1.8;
+  EXPECT_TRUE(resolve_wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch).disabled.empty());
+  label[1] = label[0];
+  const WedgeResolution r = resolve_wedge_conflicts(mesh, cut, x, fs, label, is_new, kMaxStretch, kMaxStretch);
+  EXPECT_TRUE(r.disabled.empty());
+  ASSERT_EQ(r.relabeled.size(), 1u);
+  EXPECT_EQ(r.relabeled[0], 1);
 }
 
 }  // namespace

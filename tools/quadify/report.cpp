@@ -247,6 +247,8 @@ nlohmann::json to_json(const core::RepairReport& r) {
           {"invalid_faces_removed", r.invalid_faces_removed},
           {"welded_vertices", r.welded_vertices},
           {"degenerate_faces_removed", r.degenerate_faces_removed},
+          {"caps_removed", r.caps_removed},
+          {"folds_flipped", r.folds_flipped},
           {"duplicate_faces_removed", r.duplicate_faces_removed},
           {"unreferenced_vertices_removed", r.unreferenced_vertices_removed},
           {"faces_reoriented", r.faces_reoriented},

@@ -16,6 +16,23 @@ struct RepairOptions {
   double weld_tolerance = 1e-7;
   // A face whose area is below this, relative to diagonal², is degenerate and dropped.
   double degenerate_area_tolerance = 1e-14;
+  // A "cap", a triangle with an angle of at least this (degrees), is removed like a zero-area
+  // one: the neighbour across its long edge is split at the cap's vertex, which lies almost on
+  // that edge (the surface moves by the cap's height). CAD tessellations leave such slivers along
+  // curves; their normals are noise, so their edges would look sharp and become false features
+  // that fold back on the real ones. A cap is kept where the split would join two vertices that
+  // are already joined (the result would not be manifold). Caps down to 150° are removed too
+  // where their two short edges are creases (dihedral ≥ 30°) and the neighbour is flat with
+  // them: a feature curve's vertex whose single triangle spans the chord, a wedge that no
+  // seamless map can straighten (the flip gives it a second corner; the surface does not
+  // move). 180 = off.
+  double cap_angle_deg = 178;
+  // A fold: two triangles on an edge that lie almost on top of each other, face to face (their
+  // normals more than this apart, degrees, and one's far vertex within 2% of the edge length
+  // of the other's plane). CAD tessellations leave slivers folded over a neighbour along
+  // curves. The edge is flipped when the two new triangles agree (normals within 30°): the
+  // double-covered sliver disappears and the surface is as before. 180 = off.
+  double fold_angle_deg = 150;
   bool orient_components = true;          // make each component consistently oriented
   bool split_nonmanifold_vertices = true;  // give each fan of a non-manifold vertex its own copy
   bool split_nonmanifold_edges = true;     // detach faces beyond a consistent pair on an edge
@@ -29,6 +46,8 @@ struct RepairReport {
   int invalid_faces_removed = 0;        // degree < 3 or repeated vertex ids
   int welded_vertices = 0;              // vertices merged into another
   int degenerate_faces_removed = 0;     // zero-area (collinear or collapsed) triangles
+  int caps_removed = 0;                 // caps (see RepairOptions::cap_angle_deg)
+  int folds_flipped = 0;                // edges of folded triangle pairs flipped
   int duplicate_faces_removed = 0;      // same vertex set as an earlier face
   int unreferenced_vertices_removed = 0;
   int faces_reoriented = 0;             // flipped to agree with their component
