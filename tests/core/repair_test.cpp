@@ -104,16 +104,15 @@ TEST(Repair, QuadsAreTriangulated) {
   EXPECT_EQ(r.mesh.n_faces(), 12);
 }
 
-TEST(Repair, DegenerateCapIsRemovedKeepingTheSurfaceClosed) {
-  // Split cube edge (0,2) at its midpoint m on one side only: the triangle (0, m, 2) is a
-  // zero-area cap glued into the T-junction. Repair must keep the cube closed.
+// The cube with edge (0,2) split at m = (0, 0.5, z) on one side only: faces (0,3,m),(m,3,2)
+// instead of (0,3,2), and the cap (0, m, 2) glued into the T-junction (zero area for z = 0).
+PolyMesh cube_with_cap(double z) {
   PolyMesh m = cube_tris();
   const int mid = m.n_vertices();
-  m.V.conservativeResize(mid + 1, 3);
-  m.V.row(mid) << 0, 0.5, 0;
-  // Face (0,1,3),(0,3,2) on x=0 uses edge 2→0 in (0,3,2); replace it by (0,3,m),(m,3,2).
   PolyMesh out;
   out.V = m.V;
+  out.V.conservativeResize(mid + 1, 3);
+  out.V.row(mid) << 0, 0.5, z;
   for (int f = 0; f < m.n_faces(); ++f) {
     std::vector<int> t = {m.vertex(f, 0), m.vertex(f, 1), m.vertex(f, 2)};
     if (t == std::vector<int>{0, 3, 2}) {
@@ -124,7 +123,11 @@ TEST(Repair, DegenerateCapIsRemovedKeepingTheSurfaceClosed) {
     }
   }
   out.add_face({0, mid, 2});  // the cap fills the slit between 0→2 and 2→m→0
-  const RepairResult r = repair_mesh(out);
+  return out;
+}
+
+TEST(Repair, DegenerateCapIsRemovedKeepingTheSurfaceClosed) {
+  const RepairResult r = repair_mesh(cube_with_cap(0));
   expect_closed_genus(r, 1, 0, "cap");
   EXPECT_GE(r.report.degenerate_faces_removed, 1);
 }
@@ -150,23 +153,8 @@ Eigen::Vector3d area_vector(const TriMesh& m) {
 }
 
 TEST(Repair, NearlyDegenerateCapIsRemovedKeepingTheSurface) {
-  // As above, but the cap's vertex is 0.002 off the cube edge (angle 179.5°, not zero area).
-  PolyMesh m = cube_tris();
-  const int mid = m.n_vertices();
-  m.V.conservativeResize(mid + 1, 3);
-  m.V.row(mid) << 0, 0.5, 0.002;
-  PolyMesh out;
-  out.V = m.V;
-  for (int f = 0; f < m.n_faces(); ++f) {
-    std::vector<int> t = {m.vertex(f, 0), m.vertex(f, 1), m.vertex(f, 2)};
-    if (t == std::vector<int>{0, 3, 2}) {
-      out.add_face({0, 3, mid});
-      out.add_face({mid, 3, 2});
-    } else {
-      out.add_face(t);
-    }
-  }
-  out.add_face({0, mid, 2});
+  // The cap's vertex 0.002 off the cube edge (angle 179.5°, not zero area).
+  const PolyMesh out = cube_with_cap(0.002);
   RepairOptions keep;
   keep.cap_angle_deg = 180;
   const RepairResult kept = repair_mesh(out, keep);

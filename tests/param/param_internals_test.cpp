@@ -360,6 +360,20 @@ TEST(LocalEstimation, PicksTheSideMatchingTheAngleDefect) {
   EXPECT_EQ(pc.n_faces, 3);
 }
 
+// The edges from the centre of test::make_disk(·, 12) to ring vertex 1 and to the vertex `sectors`
+// sectors on (-1 when missing).
+std::vector<int> disk_spokes(const CutMesh& cut, int sectors) {
+  std::vector<int> spokes(2, -1);
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    for (int k = 0; k < 2; ++k)
+      if (cut.topo.edge_vertex(e, k) == 0) {
+        const int w = cut.topo.edge_vertex(e, 1 - k);
+        if (w == 1) spokes[0] = e;
+        if (w == 1 + sectors) spokes[1] = e;
+      }
+  return spokes;
+}
+
 TEST(FeatureAlignment, WedgeCheckUsesTheChosenAxisNotTheNearest) {
   // Two opposite spokes of a disk's centre continue each other (180° on the surface). Labeled
   // alike they stay straight; if local estimation gives one of them the other axis, the pair
@@ -367,14 +381,7 @@ TEST(FeatureAlignment, WedgeCheckUsesTheChosenAxisNotTheNearest) {
   const core::TriMesh mesh = test::make_disk(4, 12);
   const CutMesh cut = cut_along_dual_tree(mesh, 0);
   const Eigen::VectorXd x = flatten(isometric_unfold(mesh, cut));
-  std::vector<int> spokes(2, -1);
-  for (int e = 0; e < cut.topo.n_edges(); ++e)
-    for (int k = 0; k < 2; ++k)
-      if (cut.topo.edge_vertex(e, k) == 0) {
-        const int w = cut.topo.edge_vertex(e, 1 - k);
-        if (w == 1) spokes[0] = e;
-        if (w == 1 + 6) spokes[1] = e;  // sector 6 of 12: the opposite direction
-      }
+  const std::vector<int> spokes = disk_spokes(cut, 6);  // sector 6 of 12: the opposite direction
   ASSERT_GE(spokes[0], 0);
   ASSERT_GE(spokes[1], 0);
   const FeatureSet fs = make_feature_set(cut, spokes);
@@ -402,14 +409,7 @@ TEST(FeatureAlignment, WedgeCheckGivesACornerFeatureNear45DegreesItsOtherAxis) {
   const core::TriMesh mesh = test::make_disk(4, 12);
   const CutMesh cut = cut_along_dual_tree(mesh, 0);
   Eigen::VectorXd x = flatten(isometric_unfold(mesh, cut));
-  std::vector<int> spokes(2, -1);
-  for (int e = 0; e < cut.topo.n_edges(); ++e)
-    for (int k = 0; k < 2; ++k)
-      if (cut.topo.edge_vertex(e, k) == 0) {
-        const int w = cut.topo.edge_vertex(e, 1 - k);
-        if (w == 1) spokes[0] = e;
-        if (w == 1 + 3) spokes[1] = e;  // sector 3 of 12: a quarter turn on
-      }
+  const std::vector<int> spokes = disk_spokes(cut, 3);  // sector 3 of 12: a quarter turn on
   ASSERT_GE(spokes[0], 0);
   ASSERT_GE(spokes[1], 0);
   const FeatureSet fs = make_feature_set(cut, spokes);
