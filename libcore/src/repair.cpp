@@ -18,21 +18,13 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace quadify::core {
 namespace {
 
 using Tri = std::array<int, 3>;
 
-// Caps with an angle of at least this (degrees) but below RepairOptions::cap_angle_deg are removed
-// where the neighbour across their long edge is flat with them: the cap's vertex within
-// kFlatCapTolerance of the long edge's length of the neighbour's plane. The flip only
-// re-triangulates a flat quad, and a wedge between two feature edges (a curve's vertex whose
-// triangle spans the chord) gets a second corner, which seamless maps need to keep it straight.
-constexpr double kFlatCapAngleDeg = 150;
-constexpr double kFlatCapTolerance = 0.01;
-// ... and only between two creases: both short edges' dihedral angles at least this (degrees).
-constexpr double kFlatCapCreaseDeg = 30;
 
 struct DisjointSets {
   std::vector<int> parent;
@@ -249,11 +241,9 @@ class Repairer {
     }
     return best;
   }
-  // A cap to remove: an angle of at least cap_angle_deg, or of at least kFlatCapAngle when the
-  // neighbour across the long edge is flat with it (checked at the removal).
+  // A cap: an angle of at least cap_angle_deg.
   bool is_cap(const Tri& t) const {
-    return opt_.cap_angle_deg < 180 &&
-           max_angle(t) >= std::min(opt_.cap_angle_deg, kFlatCapAngleDeg) * (std::numbers::pi / 180);
+    return opt_.cap_angle_deg < 180 && max_angle(t) >= opt_.cap_angle_deg * (std::numbers::pi / 180);
   }
 
   // Removes each zero-area triangle and each cap (a, m, b), m opposite its longest edge (a, b),
@@ -305,28 +295,10 @@ class Repairer {
       }
       if (!zero && (g < 0 || c == m || !edge_faces[edge_key(m, c)].empty())) continue;
       if (!zero) {
-        // The two new triangles must face like the neighbour they replace; below cap_angle_deg
-        // the cap's vertex must also lie in the neighbour's plane (the surface stays as it is).
+        // The two new triangles must face like the neighbour they replace.
         const Eigen::Vector3d pa = V_.row(a), pb = V_.row(b), pc = V_.row(c), pm = V_.row(m);
         const Eigen::Vector3d n = (pb - pa).cross(pc - pa);
         if (n.dot((pm - pa).cross(pc - pa)) <= 0 || n.dot((pb - pm).cross(pc - pm)) <= 0) continue;
-        // Each removal lowers the largest angle where it acts, so removals cannot cycle.
-        if (std::max(max_angle({a, m, c}), max_angle({m, b, c})) >= max_angle(t)) continue;
-        const bool sharp_cap = max_angle(t) >= opt_.cap_angle_deg * (std::numbers::pi / 180);
-        if (!sharp_cap && std::abs(n.normalized().dot(pm - pa)) > kFlatCapTolerance * (pb - pa).norm())
-          continue;
-        // Below cap_angle_deg only the caps between two creases: a curve's vertex m whose one
-        // triangle spans the chord a-b (elsewhere the flip would only perturb the tessellation).
-        if (!sharp_cap) {
-          const Eigen::Vector3d nt = (pm - pa).cross(pb - pa).normalized();
-          auto crease = [&](int p, int q) {
-            for (const int h : edge_faces[edge_key(p, q)])
-              if (h != f && std::abs(normal(tris_[h]).normalized().dot(nt)) < std::cos(kFlatCapCreaseDeg * std::numbers::pi / 180))
-                return true;
-            return false;
-          };
-          if (!crease(a, m) || !crease(m, b)) continue;
-        }
       }
       unlink(f);
       alive_[f] = 0;
@@ -641,6 +613,67 @@ bool RepairReport::changed() const {
 
 RepairResult repair_mesh(const PolyMesh& input, const RepairOptions& options) {
   return Repairer(input, options).run();
+}
+
+int flip_feature_wedges(TriMesh* mesh, const std::vector<std::array<int, 2>>& feature_edges,
+                        double min_angle_deg) {
+  constexpr double kFlatTolerance = 0.01;  // of the long edge's length
+  std::unordered_set<long long> feature;
+  for (const auto& e : feature_edges) feature.insert(edge_key(e[0], e[1]));
+  TriMesh& m = *mesh;
+  const int nf = m.n_faces();
+  std::unordered_map<long long, std::vector<int>> edge_faces;
+  for (int f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) edge_faces[edge_key(m.F(f, k), m.F(f, (k + 1) % 3))].push_back(f);
+  auto point = [&](int v) { return Eigen::Vector3d(m.V.row(v)); };
+  auto angle_at = [&](int p, int q, int r) {  // at p, in triangle (p, q, r)
+    const Eigen::Vector3d u = point(q) - point(p), w = point(r) - point(p);
+    return std::atan2(u.cross(w).norm(), u.dot(w));
+  };
+  auto max_angle = [&](int p, int q, int r) {
+    return std::max({angle_at(p, q, r), angle_at(q, r, p), angle_at(r, p, q)});
+  };
+  const double min_angle = min_angle_deg * (std::numbers::pi / 180);
+  std::vector<char> touched(nf, 0);
+  int n_flipped = 0;
+  for (int f = 0; f < nf; ++f) {
+    if (touched[f]) continue;
+    for (int k = 0; k < 3; ++k) {
+      // f = (a, b, w) with the wide angle at w, between the features w-a and b-w.
+      const int a = m.F(f, (k + 1) % 3), b = m.F(f, (k + 2) % 3), w = m.F(f, k);
+      if (angle_at(w, a, b) < min_angle || !feature.count(edge_key(w, a)) ||
+          !feature.count(edge_key(b, w)) || feature.count(edge_key(a, b)))
+        continue;
+      const auto it = edge_faces.find(edge_key(a, b));
+      if (it == edge_faces.end() || it->second.size() != 2) continue;
+      const int g = it->second[0] == f ? it->second[1] : it->second[0];
+      if (touched[g]) continue;
+      int c = -1;
+      for (int j = 0; j < 3; ++j)
+        if (m.F(g, j) == b && m.F(g, (j + 1) % 3) == a) c = m.F(g, (j + 2) % 3);
+      if (c < 0 || c == w || edge_faces.count(edge_key(w, c))) continue;
+      // (b, a, c) flat with w, the new triangles (a, c, w), (c, b, w) facing like it, and smaller
+      // angles than the wedge's.
+      const Eigen::Vector3d n = (point(a) - point(b)).cross(point(c) - point(b));
+      if (std::abs(n.normalized().dot(point(w) - point(a))) > kFlatTolerance * (point(b) - point(a)).norm())
+        continue;
+      const Eigen::Vector3d n1 = (point(c) - point(a)).cross(point(w) - point(a));
+      const Eigen::Vector3d n2 = (point(b) - point(c)).cross(point(w) - point(c));
+      if (n.dot(n1) <= 0 || n.dot(n2) <= 0) continue;
+      if (std::max(max_angle(a, c, w), max_angle(c, b, w)) >= angle_at(w, a, b)) continue;
+      m.F.row(f) << a, c, w;
+      m.F.row(g) << c, b, w;
+      touched[f] = touched[g] = 1;
+      // Edge a-b goes, w-c comes; a-c moves from g to f and b-w from f to g.
+      edge_faces.erase(edge_key(a, b));
+      edge_faces[edge_key(w, c)] = {f, g};
+      for (int& h : edge_faces[edge_key(a, c)]) h = h == g ? f : h;
+      for (int& h : edge_faces[edge_key(b, w)]) h = h == f ? g : h;
+      ++n_flipped;
+      break;
+    }
+  }
+  return n_flipped;
 }
 
 }  // namespace quadify::core

@@ -169,34 +169,36 @@ TEST(Repair, NearlyDegenerateCapIsRemovedKeepingTheSurface) {
   EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-3);
 }
 
-// An open patch: the cap (a, b, m) with its vertex m 0.18 off the long edge a-b (160°), the
-// triangle (b, a, c) across that edge, and two triangles joining a, m, b to d. With d lifted, the
-// cap's short edges are creases (m is a vertex of a feature curve a-m-b whose one triangle spans
-// the chord a-b).
-PolyMesh cap_patch(double c_height, double d_height) {
+// An open patch: the triangle (a, b, w) with its vertex w 0.18 off the long edge a-b (160°), the
+// triangle (b, a, c) across that edge, and two triangles joining a, w, b to d. With d lifted, the
+// short edges a-w and w-b are creases: w is a vertex of a feature curve a-w-b whose one triangle
+// spans the chord a-b.
+PolyMesh wedge_patch(double c_height, double d_height) {
   return make_poly({{0, 0, 0}, {2, 0, 0}, {1, 0.18, 0}, {1, -1, c_height}, {1, 0.68, d_height}},
                    {{0, 1, 2}, {1, 0, 3}, {0, 2, 4}, {2, 1, 4}});
 }
 
-TEST(Repair, FlatCapBetweenCreasesIsFlippedOthersAreKept) {
-  const RepairResult flat = repair_mesh(cap_patch(0, 1));
+TEST(Repair, FeatureWedgeIsFlippedWhereTheSurfaceStays) {
+  const std::vector<std::array<int, 2>> curve = {{0, 2}, {2, 1}};
+  const RepairResult flat = repair_mesh(wedge_patch(0, 1));
   ASSERT_TRUE(flat.status.is_ok()) << flat.status.to_string();
-  EXPECT_EQ(flat.report.caps_removed, 1);
-  EXPECT_EQ(flat.mesh.n_faces(), 4);
-  EXPECT_LT(largest_angle_deg(flat.mesh), 150);
-  RepairOptions off;
-  off.cap_angle_deg = 180;
-  EXPECT_NEAR((area_vector(flat.mesh) - area_vector(repair_mesh(cap_patch(0, 1), off).mesh)).norm(), 0, 1e-12)
+  EXPECT_EQ(flat.report.caps_removed, 0) << "160° is no cap for the repair";
+  TriMesh mesh = flat.mesh;
+  EXPECT_EQ(flip_feature_wedges(&mesh, curve), 1);
+  EXPECT_EQ(mesh.n_faces(), 4);
+  EXPECT_EQ(mesh.n_vertices(), 5);
+  EXPECT_LT(largest_angle_deg(mesh), 150);
+  EXPECT_NEAR((area_vector(mesh) - area_vector(flat.mesh)).norm(), 0, 1e-12)
       << "a flat re-triangulation keeps the area";
+  EXPECT_NO_THROW((void)build_edge_topology(mesh)) << "still manifold and oriented";
+  EXPECT_EQ(flip_feature_wedges(&mesh, curve), 0) << "nothing left to flip";
+  // Not features: left as it is.
+  TriMesh plain = flat.mesh;
+  EXPECT_EQ(flip_feature_wedges(&plain, {{0, 2}}), 0);
   // With c lifted by 0.5, the edge a-b is a crease too: flipping it would cut across it.
-  const RepairResult bent = repair_mesh(cap_patch(0.5, 1));
-  ASSERT_TRUE(bent.status.is_ok()) << bent.status.to_string();
-  EXPECT_EQ(bent.report.caps_removed, 0);
-  EXPECT_GT(largest_angle_deg(bent.mesh), 159);
-  // All flat: a 160° triangle is only a tessellation's choice there, left as it is.
-  const RepairResult plain = repair_mesh(cap_patch(0, 0));
-  ASSERT_TRUE(plain.status.is_ok()) << plain.status.to_string();
-  EXPECT_EQ(plain.report.caps_removed, 0);
+  TriMesh bent = repair_mesh(wedge_patch(0.5, 1)).mesh;
+  EXPECT_EQ(flip_feature_wedges(&bent, curve), 0);
+  EXPECT_GT(largest_angle_deg(bent), 159);
 }
 
 TEST(Repair, FoldedSliverIsFlippedAway) {

@@ -30,11 +30,11 @@ const std::map<std::string, param::RoundingOrder> kOrders = {
 
 int run_param(const ParamArgs& args, const CommonOptions& common) {
   Progress progress(common.quiet);
-  const LoadedMesh loaded = load_and_repair(args.input, progress);
+  LoadedMesh loaded = load_and_repair(args.input, progress);
 
   param::ParamOptions options = args.options;
   options.threads = common.threads;
-  const FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &options);
+  const FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &options);
   SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   sizing.apply_to(&options);
   options.progress = [&progress](const std::string& stage, int step, int n_steps) {

@@ -55,7 +55,7 @@ void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* option
 
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   Progress progress(common.quiet);
-  const LoadedMesh loaded = load_and_repair(args.input, progress);
+  LoadedMesh loaded = load_and_repair(args.input, progress);
   const core::TriMesh& mesh = loaded.repaired.mesh;
   auto on_progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
@@ -77,7 +77,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
   param_options.threads = common.threads;
   param_options.progress = on_progress;
-  FeatureInput feature_input = apply_feature_args(args.features, args.input, loaded, &param_options);
+  FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &param_options);
   const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   sizing.apply_to(&param_options);
   quantize_options.face_size = sizing.face_size;

@@ -127,8 +127,10 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
 }
 
 
-FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
-                                const LoadedMesh& loaded, param::ParamOptions* options) {
+namespace {
+
+FeatureInput collect_feature_edges(const FeatureArgs& args, const std::string& input,
+                                   const LoadedMesh& loaded, param::ParamOptions* options) {
   FeatureInput fi;
   const core::TriMesh& mesh = loaded.repaired.mesh;
   const core::EdgeTopology topo = core::build_edge_topology(mesh);
@@ -217,12 +219,21 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   return fi;
 }
 
+}  // namespace
+
 void warn_feature_fallbacks(const std::string& input, const param::ParamStats& stats, bool quiet) {
   if (quiet || stats.n_feature_fallbacks == 0) return;
   std::fprintf(stderr,
                "quadify: %s: %d of %d components could not be parametrized flip-free with their "
                "features and were parametrized without them\n",
                input.c_str(), stats.n_feature_fallbacks, stats.n_components);
+}
+
+FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
+                                LoadedMesh* loaded, param::ParamOptions* options) {
+  FeatureInput fi = collect_feature_edges(args, input, *loaded, options);
+  fi.n_wedges_flipped = core::flip_feature_wedges(&loaded->repaired.mesh, options->feature_edges);
+  return fi;
 }
 
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
@@ -232,6 +243,7 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"given_edges", fi.n_given},
           {"given_edges_lost_in_repair", fi.n_lost},
           {"too_small_for_density", fi.n_too_small},
+          {"wedges_flipped", fi.n_wedges_flipped},
           {"feature_edges", s.n_feature_edges},
           {"aligned", s.n_aligned_features},
           {"disabled", s.n_disabled_features},

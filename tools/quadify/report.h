@@ -106,10 +106,13 @@ struct FeatureInput {
   int n_given = 0;     // edges from the file and the OBJ lines
   int n_lost = 0;      // given edges that the repair removed (e.g. with a degenerate face)
   int n_too_small = 0;  // edges of curves too short for the quad density (remesh only)
+  int n_wedges_flipped = 0;  // core::flip_feature_wedges on the repaired mesh
   bool soft = false;    // Alg. 3 (--feature-mode after)
 };
+// Also flips the feature wedges of loaded->repaired.mesh (core::flip_feature_wedges: faces
+// change, vertex ids stay).
 FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
-                                const LoadedMesh& loaded, param::ParamOptions* options);
+                                LoadedMesh* loaded, param::ParamOptions* options);
 nlohmann::json feature_json(const FeatureInput& input, const param::ParamStats& stats);
 
 // Sizing options shared by `param` and the remesher (paper section 7, isotropic scaling).

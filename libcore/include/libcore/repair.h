@@ -5,6 +5,7 @@
 #include <libcore/mesh.h>
 #include <libcore/status.h>
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -21,11 +22,8 @@ struct RepairOptions {
   // that edge (the surface moves by the cap's height). CAD tessellations leave such slivers along
   // curves; their normals are noise, so their edges would look sharp and become false features
   // that fold back on the real ones. A cap is kept where the split would join two vertices that
-  // are already joined (the result would not be manifold). Caps down to 150° are removed too
-  // where their two short edges are creases (dihedral ≥ 30°) and the neighbour is flat with
-  // them: a feature curve's vertex whose single triangle spans the chord, a wedge that no
-  // seamless map can straighten (the flip gives it a second corner; the surface does not
-  // move). 180 = off.
+  // are already joined (the result would not be manifold). 180 = off. (Wider wedges between
+  // two feature edges: flip_feature_wedges.)
   double cap_angle_deg = 178;
   // A fold: two triangles on an edge that lie almost on top of each other, face to face (their
   // normals more than this apart, degrees, and one's far vertex within 2% of the edge length
@@ -71,5 +69,15 @@ struct RepairResult {
 // InvalidInput with a message naming the problem (e.g. "no faces left after removing 12
 // degenerate faces") when nothing usable remains.
 RepairResult repair_mesh(const PolyMesh& input, const RepairOptions& options = {});
+
+// A feature curve's vertex w whose single triangle (a, b, w) spans the chord a-b, with an angle
+// of at least min_angle_deg at w between the feature edges w-a and b-w: no seamless map can lay
+// both features along one iso-line (one triangle corner cannot open to 180°), so one of them
+// would be disabled. Where the neighbour across a-b is flat with the triangle (w within 1% of
+// |ab| of its plane) and the two new triangles face like it, a-b is flipped: w gets a second
+// corner and the surface does not move. Vertex ids and the face count stay; only faces change.
+// Returns the number of flips. Precondition: an edge-manifold, consistently oriented mesh.
+int flip_feature_wedges(TriMesh* mesh, const std::vector<std::array<int, 2>>& feature_edges,
+                        double min_angle_deg = 150);
 
 }  // namespace quadify::core
