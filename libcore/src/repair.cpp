@@ -299,6 +299,8 @@ class Repairer {
         const Eigen::Vector3d pa = V_.row(a), pb = V_.row(b), pc = V_.row(c), pm = V_.row(m);
         const Eigen::Vector3d n = (pb - pa).cross(pc - pa);
         if (n.dot((pm - pa).cross(pc - pa)) <= 0 || n.dot((pb - pm).cross(pc - pm)) <= 0) continue;
+        // Each removal lowers the largest angle where it acts, so removals cannot cycle.
+        if (std::max(max_angle({a, m, c}), max_angle({m, b, c})) >= max_angle(t)) continue;
       }
       unlink(f);
       alive_[f] = 0;
