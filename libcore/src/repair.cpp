@@ -25,6 +25,14 @@ namespace {
 
 using Tri = std::array<int, 3>;
 
+// The largest angle (radians) of the triangle (p, q, r).
+double largest_angle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+  auto at = [](const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const Eigen::Vector3d u = a - o, w = b - o;
+    return std::atan2(u.cross(w).norm(), u.dot(w));
+  };
+  return std::max({at(p, q, r), at(q, r, p), at(r, p, q)});
+}
 
 struct DisjointSets {
   std::vector<int> parent;
@@ -230,16 +238,8 @@ class Repairer {
     return 0.5 * (b - a).cross(c - a).norm() < opt_.degenerate_area_tolerance * diag_ * diag_;
   }
 
-  // The largest angle of a triangle (radians).
   double max_angle(const Tri& t) const {
-    double best = 0;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d p = V_.row(t[k]);
-      const Eigen::Vector3d u = Eigen::Vector3d(V_.row(t[(k + 1) % 3])) - p;
-      const Eigen::Vector3d w = Eigen::Vector3d(V_.row(t[(k + 2) % 3])) - p;
-      best = std::max(best, std::atan2(u.cross(w).norm(), u.dot(w)));
-    }
-    return best;
+    return largest_angle(V_.row(t[0]), V_.row(t[1]), V_.row(t[2]));
   }
   // A cap: an angle of at least cap_angle_deg.
   bool is_cap(const Tri& t) const {
@@ -609,8 +609,8 @@ class Repairer {
 
 bool RepairReport::changed() const {
   return polygons_triangulated || invalid_faces_removed || welded_vertices ||
-         degenerate_faces_removed || caps_removed || folds_flipped || duplicate_faces_removed || unreferenced_vertices_removed ||
-         faces_reoriented || nonmanifold_edges_split || nonmanifold_vertices_split;
+         degenerate_faces_removed || caps_removed || folds_flipped || duplicate_faces_removed ||
+         unreferenced_vertices_removed || faces_reoriented || nonmanifold_edges_split || nonmanifold_vertices_split;
 }
 
 RepairResult repair_mesh(const PolyMesh& input, const RepairOptions& options) {
@@ -632,9 +632,7 @@ int flip_feature_wedges(TriMesh* mesh, const std::vector<std::array<int, 2>>& fe
     const Eigen::Vector3d u = point(q) - point(p), w = point(r) - point(p);
     return std::atan2(u.cross(w).norm(), u.dot(w));
   };
-  auto max_angle = [&](int p, int q, int r) {
-    return std::max({angle_at(p, q, r), angle_at(q, r, p), angle_at(r, p, q)});
-  };
+  auto max_angle = [&](int p, int q, int r) { return largest_angle(point(p), point(q), point(r)); };
   const double min_angle = min_angle_deg * (std::numbers::pi / 180);
   std::vector<char> touched(nf, 0);
   int n_flipped = 0;

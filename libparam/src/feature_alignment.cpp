@@ -16,12 +16,12 @@ constexpr int kRotationIterations = 20;
 // along one direction: their wedge closes.
 constexpr double kMinWedge = std::numbers::pi / 4;
 // A feature in a wedge conflict is given its other axis only if that turns it by at most this
-// (radians; 3/4 of a quarter turn): a feature near 45° (local estimation's coin toss) switches,
+// (radians; 0.6 of a quarter turn): a feature near 45° (local estimation's coin toss) switches,
 // one clearly on its axis is disabled instead.
-// Two features at a vertex whose surface angle is within this of 180° (radians) continue one
-// curve.
-constexpr double kStraightContinuation = std::numbers::pi / 6;
 constexpr double kMaxRelabelTurn = 0.6 * std::numbers::pi / 2;
+// Two features at a vertex whose surface angle is within this of 180° (radians) continue one
+// curve; there a conflict is where the label must switch, and no relabeling is tried.
+constexpr double kStraightContinuation = std::numbers::pi / 6;
 
 int next_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 1) % 3; }
 int prev_in_face(int halfedge) { return 3 * (halfedge / 3) + (halfedge % 3 + 2) % 3; }

@@ -49,8 +49,8 @@ double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, cons
 // by its rounding δ to its axis; two consecutive ones whose target directions are less than
 // 45° apart would close the faces between them (both along one direction). One feature of each
 // such pair (a new one, the one farther from its axis) is first given its other axis, if that
-// turns it by less than 3/4 of a quarter turn; if it still conflicts, it is disabled; until no
-// pair remains.
+// turns it by at most 0.6 of a quarter turn and the two do not continue each other straight;
+// if it still conflicts, it is disabled; until no pair remains.
 // A pair whose wedge would open or close by more than max_ratio (its target angle, a multiple of
 // 90°, against its angle on the surface) is a conflict too: it would cost a distortion of about
 // that ratio. A wedge bounded by a boundary edge (where an open mesh needs its corners) uses

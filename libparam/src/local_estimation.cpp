@@ -127,16 +127,7 @@ LocalEstimator::Alternatives LocalEstimator::evaluate(
     const OptimizeReport rep = optimize_layout(dom, red, st, &y);
     if (!rep.status.is_ok()) return;
     *value = rep.energy;
-    const Eigen::VectorXd xl = red.expand(y);
-    double s1max = 0, s2min = std::numeric_limits<double>::infinity();
-    for (int f = 0; f < dom.n_faces(); ++f) {
-      const Eigen::Matrix2d J = face_jacobian(dom, f, xl);
-      const double ps = std::hypot(J(0, 0) + J(1, 1), J(1, 0) - J(0, 1));
-      const double pa = std::hypot(J(0, 0) - J(1, 1), J(0, 1) + J(1, 0));
-      s1max = std::max(s1max, 0.5 * (ps + pa));
-      s2min = std::min(s2min, 0.5 * (ps - pa));
-    }
-    if (s2min > 0) *tau = std::sqrt(s1max / s2min);
+    *tau = max_isometric_distortion(dom, red.expand(y));
   };
   for (int side = 0; side < 2; ++side) {
     ConstraintEliminator elim = base;
