@@ -228,6 +228,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
 
   const bool soft_features = options.feature_mode == FeatureMode::kAfterRounding;
   const LocalEstimator estimator(mesh, cut, domain, options.patch_bfs_levels, &fs);
+  // Why a feature was disabled (for the report).
+  enum : char { kNotDisabled, kByTau, kByWedge, kByFlips };
+  std::vector<char> disabled_reason(fs.size(), kNotDisabled);
   // Labels of uncertain features by local estimation (patches independent: parallel,
   // deterministic); a label whose better patch still exceeds feature_max_tau is disabled.
   auto estimate_feature_labels = [&](const std::vector<int>& uncertain, std::vector<int>* proposed) {
@@ -250,6 +253,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       int l = fc.label;
       if (!acceptable(l) && acceptable(1 - l)) l = 1 - l;
       (*proposed)[uncertain[u]] = acceptable(l) ? l : kDisabled;
+      if (!acceptable(l)) disabled_reason[uncertain[u]] = kByTau;
     }
     out.stats.seconds_local_estimation += seconds_since(tl);
   };
@@ -325,7 +329,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       const WedgeResolution wr = resolve_wedge_conflicts(
           mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
       for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
-      for (const int i : wr.disabled) proposed[i] = kDisabled;
+      for (const int i : wr.disabled) {
+        proposed[i] = kDisabled;
+        disabled_reason[i] = kByWedge;
+      }
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
@@ -391,15 +398,20 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
           const int h = fs.halfedge[i];
           // Before the last batch they wait for the next one (more matchings fixed, the layout
           // moved); in the last batch they are disabled.
-          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)])
+          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)]) {
             proposed[i] = last ? kDisabled : kUnlabeled;
-          else
+            if (last) disabled_reason[i] = kByFlips;
+          } else {
             ++n_kept;
+          }
         }
       }
       if (retry == 1 || n_kept == static_cast<int>(batch_feature_rows.size())) {
         for (const int i : fbatch)
-          if (proposed[i] == 0 || proposed[i] == 1) proposed[i] = last ? kDisabled : kUnlabeled;
+          if (proposed[i] == 0 || proposed[i] == 1) {
+            proposed[i] = last ? kDisabled : kUnlabeled;
+            if (last) disabled_reason[i] = kByFlips;
+          }
         n_kept = 0;
       }
       elim = *elim_without_features;
@@ -568,7 +580,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     const WedgeResolution wr = resolve_wedge_conflicts(
         mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
     for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
-    for (const int i : wr.disabled) proposed[i] = kDisabled;
+    for (const int i : wr.disabled) {
+      proposed[i] = kDisabled;
+      disabled_reason[i] = kByWedge;
+    }
     label = proposed;
     // Features next to a face stretched beyond feature_max_tau by the pull (max(σ1, 1/σ2): labels
     // that the fixed matchings cannot honour without crushing triangles) are disabled, and the
@@ -607,6 +622,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         const int h = fs.halfedge[i], t = cut.topo.twin[h];
         if (stretched[h / 3] || (t >= 0 && stretched[t / 3])) {
           label[i] = kDisabled;
+          disabled_reason[i] = kByTau;
           ++n_disabled;
         }
       }
@@ -685,7 +701,12 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   // Aligned features.
   for (int i = 0; i < fs.size(); ++i) {
-    if (label[i] == kDisabled) ++out.stats.n_disabled_features;
+    if (label[i] == kDisabled) {
+      ++out.stats.n_disabled_features;
+      out.stats.n_disabled_by_tau += disabled_reason[i] == kByTau;
+      out.stats.n_disabled_by_wedge += disabled_reason[i] == kByWedge;
+      out.stats.n_disabled_by_flips += disabled_reason[i] == kByFlips;
+    }
     if (label[i] != 0 && label[i] != 1) continue;
     const int h = fs.halfedge[i];
     out.features.push_back({h / 3, h % 3, label[i]});
@@ -895,6 +916,9 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_feature_fallbacks += fell_back[c];
     st.n_aligned_features += o.stats.n_aligned_features;
     st.n_disabled_features += o.stats.n_disabled_features;
+    st.n_disabled_by_tau += o.stats.n_disabled_by_tau;
+    st.n_disabled_by_wedge += o.stats.n_disabled_by_wedge;
+    st.n_disabled_by_flips += o.stats.n_disabled_by_flips;
     st.n_feature_patches += o.stats.n_feature_patches;
     st.feature_alignment_error = std::max(st.feature_alignment_error, o.stats.feature_alignment_error);
     st.n_direction_faces += o.stats.n_direction_faces;

@@ -60,6 +60,8 @@ TEST(SeamlessParamBenchmark, FandiskFeatures) {
   EXPECT_EQ(s.n_feature_edges, 697);
   EXPECT_GE(s.n_aligned_features, 670);
   EXPECT_EQ(s.n_aligned_features + s.n_disabled_features, s.n_feature_edges);
+  // Every disabled feature has its reason (no component fell back to a map without features).
+  EXPECT_EQ(s.n_disabled_by_tau + s.n_disabled_by_wedge + s.n_disabled_by_flips, s.n_disabled_features);
   EXPECT_LT(s.feature_alignment_error, 1e-9);
   EXPECT_LT(s.tau, 3.5);
 }

@@ -345,6 +345,8 @@ TEST(FeatureAlignment, WedgeOfTwoCloseFeaturesKeepsOne) {
   EXPECT_EQ(r.stats.n_feature_edges, 2);
   EXPECT_EQ(r.stats.n_aligned_features, 1);
   EXPECT_EQ(r.stats.n_disabled_features, 1);
+  EXPECT_EQ(r.stats.n_disabled_by_wedge, 1);
+  EXPECT_EQ(r.stats.n_disabled_by_tau + r.stats.n_disabled_by_flips, 0);
 }
 
 TEST(FeatureAlignment, RejectsAPairThatIsNotAnEdge) {

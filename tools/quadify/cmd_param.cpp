@@ -68,8 +68,9 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
       std::printf("curvature alignment: %d faces, mean angle to the axes %.1f deg (unaligned %.1f deg)\n",
                   s.n_direction_faces, s.direction_angle, s.direction_angle_initial);
     if (s.n_feature_edges > 0)
-      std::printf("features: %d edges, %d aligned, %d disabled\n", s.n_feature_edges, s.n_aligned_features,
-                  s.n_disabled_features);
+      std::printf("features: %d edges, %d aligned, %d disabled (τ bound %d, wedge conflicts %d, flips %d)\n",
+                  s.n_feature_edges, s.n_aligned_features, s.n_disabled_features, s.n_disabled_by_tau,
+                  s.n_disabled_by_wedge, s.n_disabled_by_flips);
   }
   if (!result.status.is_ok())
     std::fprintf(stderr, "quadify: warning: %s: %s\n", args.input.c_str(), result.status.message().c_str());

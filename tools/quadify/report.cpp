@@ -247,6 +247,9 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"feature_edges", s.n_feature_edges},
           {"aligned", s.n_aligned_features},
           {"disabled", s.n_disabled_features},
+          {"disabled_by_tau", s.n_disabled_by_tau},
+          {"disabled_by_wedge", s.n_disabled_by_wedge},
+          {"disabled_by_flips", s.n_disabled_by_flips},
           {"patches", s.n_feature_patches},
           {"components_without_features", s.n_feature_fallbacks},
           {"alignment_error", number(s.feature_alignment_error)}};

@@ -141,6 +141,9 @@ struct ParamStats {
   int n_aligned_features = 0;  // feature edges aligned in the result (see ParamResult::features)
   int n_disabled_features = 0; // feature edges whose alignment was disabled (τ bound, wedge
                                // conflicts, or a batch that could not be made flip-free)
+  int n_disabled_by_tau = 0;    // of those: local τ above feature_max_tau (or stretched, Alg. 3)
+  int n_disabled_by_wedge = 0;  // of those: wedge conflicts with a neighbouring feature
+  int n_disabled_by_flips = 0;  // of those: the batch could not be made flip-free with them
   int n_feature_patches = 0;   // local-estimation patches laid out for feature labels
   int n_feature_fallbacks = 0; // components that failed with their features and were
                                // parametrized again without them (all counted as disabled)
