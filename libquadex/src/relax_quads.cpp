@@ -16,6 +16,7 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <optional>
 #include <vector>
 
 namespace quadify::quadex {
@@ -34,6 +35,9 @@ using SegmentTree =
 // Quad vertices closer than this (× bounding-box diagonal) to a feature edge are on it.
 constexpr double kOnFeature = 1e-9;
 
+// A feature point within this (× the mean quad edge length around a vertex) of one of the
+// vertex's quad edges is met by the quads already: no snapping there.
+constexpr double kSnapCovered = 0.02;
 // Fraction of the way to the neighbour centroid tried after the full step is refused.
 constexpr double kHalfStep = 0.5;
 // Fractions of the way to the centroid of a bad quad the vertex belongs to, tried next.
@@ -94,8 +98,9 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   for (int v = 0; v < nv; ++v)
     if (vertex_quads[v].empty()) fixed[v] = 1;
+  std::vector<Segment> segments;
+  std::optional<SegmentTree> feature_tree;
   if (!options.feature_edges.empty()) {
-    std::vector<Segment> segments;
     for (const auto& [a, b] : options.feature_edges) {
       if (a < 0 || b < 0 || a >= surface.n_vertices() || b >= surface.n_vertices()) {
         res.status = core::Status::invalid_input("relax: feature edge vertex out of range");
@@ -105,13 +110,13 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       if (pa != pb) segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
     }
     if (!segments.empty()) {
-      SegmentTree features(segments.begin(), segments.end());
-      features.accelerate_distance_queries();
+      feature_tree.emplace(segments.begin(), segments.end());
+      feature_tree->accelerate_distance_queries();
       const double diag = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
       const double tol2 = (kOnFeature * diag) * (kOnFeature * diag);
       for (int v = 0; v < nv; ++v)
         if (!fixed[v] &&
-            features.squared_distance(Point(quads.V(v, 0), quads.V(v, 1), quads.V(v, 2))) <= tol2)
+            feature_tree->squared_distance(Point(quads.V(v, 0), quads.V(v, 1), quads.V(v, 2))) <= tol2)
           on_feature[v] = 1;
     }
   }
@@ -207,6 +212,43 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     }
     return total;
   };
+  // Snapping to missed features (see RelaxOptions::snap_reach), in vertex order.
+  if (feature_tree && options.snap_reach > 0) {
+    for (int v = 0; v < nv; ++v) {
+      if (fixed[v] || on_feature[v] || non_manifold[v]) continue;
+      const Eigen::Vector3d old = q.V.row(v).transpose();
+      double h = 0;
+      for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
+      h /= static_cast<double>(neighbours[v].size());
+      const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
+      const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
+      if (!((p - old).norm() <= options.snap_reach * h)) continue;
+      // p already on an edge of the quads around v: the feature is met there.
+      double covered = std::numeric_limits<double>::infinity();
+      for (int f : vertex_quads[v])
+        for (int k = 0; k < 4; ++k) {
+          const Eigen::Vector3d a = q.V.row(q.vertex(f, k)).transpose();
+          const Eigen::Vector3d b = q.V.row(q.vertex(f, (k + 1) % 4)).transpose();
+          const Eigen::Vector3d ab = b - a;
+          const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+          covered = std::min(covered, (a + t * ab - p).norm());
+        }
+      if (covered <= kSnapCovered * h) continue;
+      // Every quad around v keeps its quality or stays at least snap_min_quality.
+      std::vector<double> before;
+      for (int f : vertex_quads[v]) before.push_back(quad_quality(f));
+      q.V.row(v) = p.transpose();
+      bool keep = true;
+      for (size_t i = 0; i < before.size() && keep; ++i)
+        keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
+      if (keep) {
+        on_feature[v] = 1;
+        ++res.stats.n_snapped;
+      } else {
+        q.V.row(v) = old.transpose();
+      }
+    }
+  }
   std::vector<char> frozen(nv);
   for (int v = 0; v < nv; ++v) frozen[v] = fixed[v] || on_feature[v];
   res.stats.n_moves = relax_rounds(frozen, options.min_scaled_jacobian);

@@ -138,6 +138,54 @@ TEST(RelaxQuads, TurnsAroundQuadsFoldedOverACrease) {
   EXPECT_GT(m.sj_min, 0.0);
 }
 
+TEST(RelaxQuads, SnapsTheRowNextToAMissedCreaseOntoIt) {
+  // Rows of quad vertices at arc lengths s = 0.3 … 1.5 across box_edge's crease (s = 1), columns
+  // x = 0, 0.5, …, 4: the crease runs inside the quads between rows 0.9 and 1.2, which cut it off
+  // (as quads do where a feature edge was disabled). With the crease as a feature, the interior
+  // vertices of row 0.9 (0.1 from it, a quarter of their mean edge length) move onto it; row 1.2
+  // then finds the crease on its quads' edges and stays. The quads become planar rectangles (but
+  // at the boundary columns, which stay fixed).
+  const int columns = 8;
+  const double rows[] = {0.3, 0.6, 0.9, 1.2, 1.5};
+  const int n_rows = 5;
+  core::PolyMesh q;
+  q.V.resize(n_rows * (columns + 1), 3);
+  for (int r = 0; r < n_rows; ++r)
+    for (int i = 0; i <= columns; ++i) q.V.row(r * (columns + 1) + i) = on_box_edge(0.5 * i, rows[r]).transpose();
+  for (int r = 0; r + 1 < n_rows; ++r)
+    for (int i = 0; i < columns; ++i) {
+      const int a = r * (columns + 1) + i;
+      q.add_face({a, a + columns + 1, a + columns + 2, a + 1});
+    }
+  const core::TriMesh surface = box_edge(4);
+  RelaxOptions o;
+  o.feature_edges = {{0, 1}};  // the crease y = 0, z = 1
+  o.snap_reach = 0;
+  const RelaxResult off = relax_bad_quads(q, surface, o);
+  ASSERT_TRUE(off.status.is_ok()) << off.status.to_string();
+  EXPECT_EQ(off.stats.n_snapped, 0);
+  EXPECT_EQ(off.quads.V, q.V);
+  o.snap_reach = RelaxOptions{}.snap_reach;
+  const RelaxResult r = relax_bad_quads(q, surface, o);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_snapped, columns - 1);
+  for (int i = 0; i <= columns; ++i) {
+    const int v = 2 * (columns + 1) + i;  // row s = 0.9
+    if (i == 0 || i == columns) {
+      EXPECT_EQ(r.quads.V.row(v), q.V.row(v)) << "boundary vertex " << v << " moved";
+      continue;
+    }
+    EXPECT_NEAR(r.quads.V(v, 0), 0.5 * i, 1e-12);
+    EXPECT_NEAR(r.quads.V(v, 1), 0.0, 1e-12) << "vertex " << v << " is not on the crease";
+    EXPECT_NEAR(r.quads.V(v, 2), 1.0, 1e-12) << "vertex " << v << " is not on the crease";
+  }
+  for (int v = 0; v < q.n_vertices(); ++v)
+    if (v / (columns + 1) != 2) EXPECT_EQ(r.quads.V.row(v), q.V.row(v)) << "vertex " << v << " moved";
+  const QuadMetrics m = compute_quad_metrics(r.quads, &surface);
+  EXPECT_EQ(m.n_flipped, 0);
+  EXPECT_GT(m.sj_min, 0.9) << "only the quads at the fixed boundary columns are not rectangles";
+}
+
 TEST(RelaxQuads, RejectsBadInput) {
   core::PolyMesh q = grid(2);
   q.face_vertex[0] = 99;

@@ -244,6 +244,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"flipped_after", relax_stats.n_flipped_after},
                        {"moves", relax_stats.n_moves},
                        {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
+                       {"snapped", relax_stats.n_snapped},
                        {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");

@@ -27,6 +27,15 @@ struct RelaxOptions {
   // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains
   // (but see release_features_for_flips).
   std::vector<std::array<int, 2>> feature_edges;
+  // Snapping to features missed by the quads: a vertex (not on a feature or boundary) whose
+  // closest feature point p lies within snap_reach of its mean quad edge length, where the quads
+  // around it do not already have p on one of their edges (a crease crossing a quad or running
+  // beside a chain of quad edges), moves onto p, if every quad around it keeps a worst corner
+  // of at least snap_min_quality (or does not get worse). A crease missed by a row of quads (a disabled or
+  // released feature edge, a label switch) is then cut by them only between snapped vertices,
+  // instead of being cut off by up to half a quad. 0 = off.
+  double snap_reach = 0.5;
+  double snap_min_quality = 0.1;
   // Quads still flipped after that may move their vertices on features and boundaries too (off
   // the curve: a flipped or flat quad is worse than a crease or boundary missed by a fraction of
   // a quad), as a last resort.
@@ -42,6 +51,7 @@ struct RelaxStats {
   int n_flipped_before = 0, n_flipped_after = 0;
   int n_moves = 0;       // accepted vertex moves
   int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
+  int n_snapped = 0;     // vertices moved onto a feature they were near (see snap_reach)
   double seconds = 0;
 };
 
