@@ -214,8 +214,13 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   };
   // Snapping to missed features (see RelaxOptions::snap_reach), in vertex order.
   if (feature_tree && options.snap_reach > 0) {
+    // Vertices of faces that are not quads stay (their shape is not checked).
+    std::vector<char> touches_polygon(nv, 0);
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) != 4)
+        for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
     for (int v = 0; v < nv; ++v) {
-      if (fixed[v] || on_feature[v] || non_manifold[v]) continue;
+      if (fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v]) continue;
       const Eigen::Vector3d old = q.V.row(v).transpose();
       double h = 0;
       for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();

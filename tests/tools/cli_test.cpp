@@ -291,6 +291,11 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   EXPECT_GE(report["quads"]["feature_capture"].get<double>(), 0.999);
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
   EXPECT_EQ(report["quads"]["non_quads"], 0);
+  // Every crease is on quad edges: nothing to snap (with or without --no-feature-snap).
+  EXPECT_EQ(report["relax"]["snapped"], 0);
+  const CliRun off = quadify(args + " --no-feature-snap", dir_);
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["relax"]["snapped"], 0);
 }
 
 // A component smaller than a quad (a 2 cm flake beside a torus remeshed at 400 quads) gets no

@@ -27,6 +27,7 @@ struct RemeshArgs {
   bool keep_uv = false;
   bool measure = true;
   bool relax = true;
+  bool feature_snap = true;
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
@@ -183,6 +184,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     progress.begin("relax");
     quadex::RelaxOptions relax_options;
     relax_options.feature_edges = param_options.feature_edges;
+    if (!args.feature_snap) relax_options.snap_reach = 0;
     quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh, relax_options);
     progress.end();
     if (!relaxed.status.is_ok())
@@ -335,6 +337,9 @@ CommandRunner register_remesh(CLI::App& app) {
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "
                "scaled Jacobian below 0.2 are relaxed on the input surface)");
+  app.add_flag("!--no-feature-snap", args->feature_snap,
+               "Do not move quad vertices onto a nearby feature curve that their quads cut off (by "
+               "default, part of the relaxation; see relax.snapped in the report)");
   app.add_flag("!--no-measure", args->measure,
                "Skip the quality measures (Hausdorff distance, scaled Jacobian) of the report");
   app.add_option("--samples", args->samples, "Area samples per surface for the Hausdorff distance")

@@ -27,7 +27,8 @@ struct RelaxOptions {
   // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains
   // (but see release_features_for_flips).
   std::vector<std::array<int, 2>> feature_edges;
-  // Snapping to features missed by the quads: a vertex (not on a feature or boundary) whose
+  // Snapping to features missed by the quads: a vertex (not on a feature or boundary, and only
+  // of quads) whose
   // closest feature point p lies within snap_reach of its mean quad edge length, where the quads
   // around it do not already have p on one of their edges (a crease crossing a quad or running
   // beside a chain of quad edges), moves onto p, if every quad around it keeps a worst corner
