@@ -63,4 +63,14 @@ void write_file_atomically(const fs::path& path, const std::function<void(std::o
   write_files_atomically({AtomicFilePart{path, write}});
 }
 
+void check_can_write(const fs::path& path) {
+  const fs::path tmp = temp_path_for(path);
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw OutputError(path.string() + ": cannot create file (" + std::strerror(errno) + ")");
+  }
+  std::error_code ec;
+  fs::remove(tmp, ec);
+}
+
 }  // namespace quadify::core

@@ -157,6 +157,22 @@ TEST_F(CliTest, UnwritableReportIsInternalFailure) {
   EXPECT_NE(r.err.find("r.json"), std::string::npos) << r.err;
 }
 
+// An output folder that does not exist is reported before any work (the remesh would otherwise
+// run to the end first), naming the file; the report beside it is not written either.
+TEST_F(CliTest, UnwritableOutputFailsBeforeTheRun) {
+  const std::string spot = data_path("spot.obj").string();
+  const fs::path out = dir_ / "no/such/dir/q.obj";
+  for (const std::string sub : {"", "param "}) {
+    const CliRun r = quadify(sub + "'" + spot + "' -o '" + out.string() + "' --json '" +
+                                 (dir_ / "r.json").string() + "'",
+                             dir_);
+    EXPECT_EQ(r.exit_code, 1) << sub;
+    EXPECT_NE(r.err.find(out.string() + ": cannot create file"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << "one line, no stage ran: " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "r.json"));
+  }
+}
+
 TEST_F(CliTest, CheckQuadCubeAgainstTriangleCube) {
   write_text(dir_ / "cube.obj", kCubeTriObj);
   write_text(dir_ / "quads.obj", kCubeQuadObj);

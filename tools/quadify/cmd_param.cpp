@@ -3,6 +3,7 @@
 #include "commands.h"
 
 #include <libcore/uv_metrics.h>
+#include <libcore/atomic_file.h>
 #include <libcore/write_mesh.h>
 #include <libparam/seamless_param.h>
 
@@ -29,6 +30,7 @@ const std::map<std::string, param::RoundingOrder> kOrders = {
 
 
 int run_param(const ParamArgs& args, const CommonOptions& common) {
+  core::check_can_write(args.output);
   Progress progress(common.quiet);
   LoadedMesh loaded = load_and_repair(args.input, progress);
 

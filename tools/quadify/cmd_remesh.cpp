@@ -3,6 +3,7 @@
 // (libquadex), export — with progress per stage and the quad metrics in the report.
 #include "commands.h"
 
+#include <libcore/atomic_file.h>
 #include <libcore/write_mesh.h>
 #include <libparam/seamless_param.h>
 #include <libquadex/extract_quads.h>
@@ -55,6 +56,7 @@ void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* option
 
 
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
+  core::check_can_write(args.output);
   Progress progress(common.quiet);
   LoadedMesh loaded = load_and_repair(args.input, progress);
   const core::TriMesh& mesh = loaded.repaired.mesh;

@@ -1,6 +1,7 @@
 // quadify: triangle mesh → quad mesh. Subcommands: remesh (the default), info, check, param, compare. Exit codes: 0 ok, 2 bad input, 1 internal failure.
 #include "commands.h"
 
+#include <libcore/atomic_file.h>
 #include <libcore/status.h>
 
 #include <algorithm>
@@ -101,6 +102,7 @@ int main(int argc, char** argv) {
 #endif
 
   try {
+    if (!common.json_path.empty()) core::check_can_write(common.json_path);
     for (auto& [sub, run] : runners)
       if (sub->parsed()) return run(common);
     return cli::kExitBadInput;

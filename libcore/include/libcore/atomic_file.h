@@ -23,4 +23,9 @@ struct AtomicFilePart {
 };
 void write_files_atomically(const std::vector<AtomicFilePart>& parts);
 
+// Throws OutputError("<path>: cannot create file (<reason>)") unless a file can be created beside
+// `path` (its folder exists and is writable): checked before a long run, so that a mistyped
+// output folder is reported at once rather than after minutes of work. Leaves nothing behind.
+void check_can_write(const std::filesystem::path& path);
+
 }  // namespace quadify::core
