@@ -52,8 +52,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   const auto t0 = std::chrono::steady_clock::now();
   RelaxResult res;
   res.quads = quads;
-  if (!(options.min_scaled_jacobian <= 1) || options.max_rounds < 0 || options.rings < 0) {
-    res.status = core::Status::invalid_input("relax options: need min_scaled_jacobian ≤ 1, max_rounds ≥ 0, rings ≥ 0");
+  if (!(options.min_scaled_jacobian <= 1) || options.max_rounds < 0 || options.rings < 0 ||
+      !(options.snap_reach >= 0) || !(options.snap_min_quality <= 1)) {
+    res.status = core::Status::invalid_input(
+        "relax options: need min_scaled_jacobian ≤ 1, max_rounds ≥ 0, rings ≥ 0, snap_reach ≥ 0, "
+        "snap_min_quality ≤ 1");
     return res;
   }
   const int nv = quads.n_vertices(), nf = quads.n_faces();

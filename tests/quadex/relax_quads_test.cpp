@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 namespace quadify::quadex {
 namespace {
 
@@ -194,6 +196,11 @@ TEST(RelaxQuads, RejectsBadInput) {
   RelaxOptions bad;
   bad.max_rounds = -1;
   EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad).status.code(), core::StatusCode::kInvalidInput);
+  RelaxOptions bad_snap;
+  bad_snap.snap_reach = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad_snap).status.code(), core::StatusCode::kInvalidInput);
+  bad_snap.snap_reach = -1;
+  EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad_snap).status.code(), core::StatusCode::kInvalidInput);
 }
 
 }  // namespace
