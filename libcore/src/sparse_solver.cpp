@@ -21,21 +21,15 @@ namespace {
 constexpr Eigen::Index kSimplicialMaxSize = 4000;
 
 #ifdef QUADIFY_WITH_CHOLMOD
-// CHOLMOD of SuiteSparse 5 opens an OpenMP team of CHOLMOD_OMP_NUM_THREADS (compiled in: 4) for
-// the scatter of every large supernode, and OpenBLAS runs its own threads for the dense blocks.
-// On our 2-core machines, next to TBB's workers, those teams oversubscribe the cores: their
-// threads spin and yield (a remesh of spot made 1.1 million futex and 0.2 million sched_yield
-// calls), and under load a factorization took 4× longer (fandisk with soft features, load 6:
-// 30.8 s of factorization against 7.1 s single-threaded). So both run single-threaded; the
-// parallelism is TBB's (components, patches, per-face work). The symbols are looked up at run
-// time: nothing changes with another BLAS or a CHOLMOD without OpenMP, or when the user sets
-// OMP_NUM_THREADS, OMP_THREAD_LIMIT or OPENBLAS_NUM_THREADS.
+// OpenBLAS runs its own threads for the dense blocks; on our 2-core machines, next to TBB's
+// workers, they oversubscribe the cores (under load a factorization took 4× longer: fandisk with
+// soft features, load 6, 30.8 s of factorization against 7.1 s single-threaded). So it runs
+// single-threaded; the parallelism is TBB's (components, patches, per-face work). The symbol is
+// looked up at run time: nothing changes with another BLAS, or when the user sets
+// OPENBLAS_NUM_THREADS. CHOLMOD's own OpenMP regions: see GOMP_parallel below.
 void limit_library_threads() {
   static std::once_flag once;
   std::call_once(once, [] {
-    if (!std::getenv("OMP_NUM_THREADS") && !std::getenv("OMP_THREAD_LIMIT"))
-      if (auto* set_levels = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels")))
-        set_levels(0);  // every parallel region runs on the calling thread alone
     if (!std::getenv("OPENBLAS_NUM_THREADS"))
       if (auto* set_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads")))
         set_threads(1);
@@ -128,3 +122,22 @@ Eigen::MatrixXd SparseSolver::solve(const Eigen::MatrixXd& b) const {
 bool SparseSolver::factorized() const { return impl_->factorized; }
 
 }  // namespace quadify::core
+
+#ifdef QUADIFY_WITH_CHOLMOD
+// CHOLMOD of SuiteSparse 5 opens an OpenMP parallel region (`#pragma omp parallel for` with
+// num_threads(4) compiled in) for every supernode of every factorization, several per supernode,
+// most of them too small to split. libgomp runs even a region of one thread through a new team
+// and a closing barrier whose futex wake-up is a system call, tens of thousands per factorization.
+// With the regions serial (before: omp_set_max_active_levels(0)) that still cost a third of a
+// remesh of casting at 5,000 quads: 82 s wall, 13 s of it system time, 0.9 million futex calls.
+// This definition replaces libgomp's entry point for the whole program (the linker exports it to
+// libcholmod, which references it; a definition in the executable wins over the shared
+// library's): every region runs on the calling thread, as one thread of a team of one, which is
+// what a parallel loop without a team does (omp_get_num_threads() = 1, omp_get_thread_num() = 0).
+// casting: 82 → 56 s, output byte-identical. We parallelize with TBB, never with OpenMP; CHOLMOD
+// and OpenBLAS are the only callers, and both only run parallel loops (no synchronization
+// between threads that a single thread could deadlock on).
+extern "C" void GOMP_parallel(void (*fn)(void*), void* data, unsigned /*num_threads*/, unsigned /*flags*/) {
+  fn(data);
+}
+#endif

@@ -13,12 +13,15 @@
 
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <thread>
 
 namespace quadify::core {
 namespace {
@@ -303,6 +306,39 @@ TEST(SparseSolverTest, ReportsBadInputAsStatus) {
     EXPECT_EQ(s.code(), StatusCode::kNumericalFailure) << n << ": " << s.to_string();
     EXPECT_FALSE(solver.factorized());
   }
+}
+
+// CHOLMOD's OpenMP regions must reach libcore's serial GOMP_parallel, not libgomp's (a team and
+// a futex system call per region: a third of a remesh's time). The dynamic linker resolves
+// CHOLMOD's reference to the first definition in the global scope: the executable's, if the
+// linker exported it; otherwise libgomp's, and this test fails.
+TEST(SparseSolverTest, OpenMpRegionsRunOnTheCallingThread) {
+  if (std::string(SparseSolver::backend()) != "cholmod") GTEST_SKIP() << "no CHOLMOD";
+  SparseSolver solver;  // links sparse_solver.o, as every user of the solver does
+  using Parallel = void (*)(void (*)(void*), void*, unsigned, unsigned);
+  const auto gomp_parallel = reinterpret_cast<Parallel>(dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  ASSERT_NE(gomp_parallel, nullptr);
+  Dl_info found{}, here{};
+  ASSERT_NE(dladdr(reinterpret_cast<void*>(gomp_parallel), &found), 0);
+  ASSERT_NE(dladdr(reinterpret_cast<void*>(&path_laplacian_plus_identity), &here), 0);
+  EXPECT_EQ(found.dli_fbase, here.dli_fbase) << "GOMP_parallel comes from " << found.dli_fname;
+  struct Seen {
+    std::thread::id id;
+    int calls = 0;
+  } seen;
+  gomp_parallel([](void* p) {
+    auto* s = static_cast<Seen*>(p);
+    s->id = std::this_thread::get_id();
+    ++s->calls;
+  }, &seen, 4, 0);
+  EXPECT_EQ(seen.calls, 1);
+  EXPECT_EQ(seen.id, std::this_thread::get_id());
+  // And a large factorization (supernodal, with its regions) still solves.
+  const int n = 20000;
+  const Eigen::SparseMatrix<double> A = path_laplacian_plus_identity(n, 0.5);
+  ASSERT_TRUE(solver.factorize(A).is_ok());
+  const Eigen::VectorXd b = Eigen::VectorXd::Ones(n);
+  EXPECT_LT((A * solver.solve(b) - b).norm() / b.norm(), kSolveRelTol);
 }
 
 // --- atomic_file.h ---
