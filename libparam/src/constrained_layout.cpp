@@ -486,9 +486,16 @@ struct PinnedLayout::Impl {
             h4(2 * j + dir_axis[f], 2 * i + dir_axis[f]) +=
                 2 * dir_weight * a * dir_coef[f][j] * dir_coef[f][i];
         }
+      // M'·g4 and M'·h4·M column by column: no temporaries, no GEMM set-up for a k×k result.
       const Face& el = faces[f];
-      face_g[f].noalias() = el.M.transpose() * g4;
-      face_h[f].noalias() = el.M.transpose() * h4 * el.M;
+      const Eigen::Index k = el.M.cols();
+      face_g[f].resize(k);  // no-ops after the first evaluation
+      face_h[f].resize(k, k);
+      for (Eigen::Index i = 0; i < k; ++i) {
+        const Eigen::Vector4d hm = h4 * el.M.col(i);
+        face_g[f][i] = el.M.col(i).dot(g4);
+        for (Eigen::Index j = 0; j <= i; ++j) face_h[f](j, i) = face_h[f](i, j) = el.M.col(j).dot(hm);
+      }
     });
     double energy = 0;
     for (int f = 0; f < nf; ++f) {
