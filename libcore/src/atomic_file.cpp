@@ -22,9 +22,15 @@ fs::path temp_path_for(const fs::path& target) {
   return dir / name;
 }
 
-void write_temp(const fs::path& target, const fs::path& tmp, const std::function<void(std::ostream&)>& write) {
+// Creates (truncates) the temporary file tmp for target; OutputError naming target on failure.
+std::ofstream open_temp(const fs::path& target, const fs::path& tmp) {
   std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw OutputError(target.string() + ": cannot create file (" + std::strerror(errno) + ")");
+  return out;
+}
+
+void write_temp(const fs::path& target, const fs::path& tmp, const std::function<void(std::ostream&)>& write) {
+  std::ofstream out = open_temp(target, tmp);
   try {
     write(out);
   } catch (const OutputError&) {
@@ -65,10 +71,7 @@ void write_file_atomically(const fs::path& path, const std::function<void(std::o
 
 void check_can_write(const fs::path& path) {
   const fs::path tmp = temp_path_for(path);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw OutputError(path.string() + ": cannot create file (" + std::strerror(errno) + ")");
-  }
+  open_temp(path, tmp).close();
   std::error_code ec;
   fs::remove(tmp, ec);
 }

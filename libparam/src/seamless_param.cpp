@@ -257,6 +257,17 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     out.stats.seconds_local_estimation += seconds_since(tl);
   };
+  // The wedge check over the proposed labels (is_new: labels of this step): relabels or
+  // disables the conflicting ones in *proposed.
+  auto resolve_wedges = [&](const std::vector<char>& is_new, std::vector<int>* proposed) {
+    const WedgeResolution wr = resolve_wedge_conflicts(
+        mesh, cut, x, fs, *proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
+    for (const int i : wr.relabeled) (*proposed)[i] = 1 - (*proposed)[i];
+    for (const int i : wr.disabled) {
+      (*proposed)[i] = kDisabled;
+      disabled_reason[i] = kByWedge;
+    }
+  };
   const int n_steps =
       static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
   for (int step = 0; step < n_steps; ++step) {
@@ -326,13 +337,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       if (!uncertain_features.empty()) {
         estimate_feature_labels(uncertain_features, &proposed);
       }
-      const WedgeResolution wr = resolve_wedge_conflicts(
-          mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
-      for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
-      for (const int i : wr.disabled) {
-        proposed[i] = kDisabled;
-        disabled_reason[i] = kByWedge;
-      }
+      resolve_wedges(is_new, &proposed);
     }
     const auto to = Clock::now();
     std::vector<SparseRow> new_rows;
@@ -379,6 +384,12 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     for (int retry = 0; retry < 2 && elim_without_features && (!tr.status.is_ok() || tr.n_flipped > 0);
          ++retry) {
       int n_kept = 0;
+      // Before the last batch a feature waits for the next one (more matchings fixed, the layout
+      // moved); in the last batch it is disabled.
+      auto wait_or_disable = [&](int i) {
+        proposed[i] = last ? kDisabled : kUnlabeled;
+        if (last) disabled_reason[i] = kByFlips;
+      };
       if (retry == 0) {
         std::vector<char> near(mesh.n_vertices(), 0);
         for (int f = 0; f < mesh.n_faces(); ++f) {
@@ -396,22 +407,15 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         for (const int i : fbatch) {
           if (proposed[i] != 0 && proposed[i] != 1) continue;
           const int h = fs.halfedge[i];
-          // Before the last batch they wait for the next one (more matchings fixed, the layout
-          // moved); in the last batch they are disabled.
-          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)]) {
-            proposed[i] = last ? kDisabled : kUnlabeled;
-            if (last) disabled_reason[i] = kByFlips;
-          } else {
+          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)])
+            wait_or_disable(i);
+          else
             ++n_kept;
-          }
         }
       }
       if (retry == 1 || n_kept == static_cast<int>(batch_feature_rows.size())) {
         for (const int i : fbatch)
-          if (proposed[i] == 0 || proposed[i] == 1) {
-            proposed[i] = last ? kDisabled : kUnlabeled;
-            if (last) disabled_reason[i] = kByFlips;
-          }
+          if (proposed[i] == 0 || proposed[i] == 1) wait_or_disable(i);
         n_kept = 0;
       }
       elim = *elim_without_features;
@@ -577,13 +581,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         uncertain_features.push_back(i);
     }
     estimate_feature_labels(uncertain_features, &proposed);
-    const WedgeResolution wr = resolve_wedge_conflicts(
-        mesh, cut, x, fs, proposed, is_new, options.feature_max_wedge_stretch, options.feature_max_tau);
-    for (const int i : wr.relabeled) proposed[i] = 1 - proposed[i];
-    for (const int i : wr.disabled) {
-      proposed[i] = kDisabled;
-      disabled_reason[i] = kByWedge;
-    }
+    resolve_wedges(is_new, &proposed);
     label = proposed;
     // Features next to a face stretched beyond feature_max_tau by the pull (max(σ1, 1/σ2): labels
     // that the fixed matchings cannot honour without crushing triangles) are disabled, and the

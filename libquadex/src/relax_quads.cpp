@@ -215,45 +215,48 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     }
     return total;
   };
-  // Snapping to missed features (see RelaxOptions::snap_reach), in vertex order.
+  // Moves vertex v onto the closest point p of the features when p is within snap_reach of v's
+  // mean quad edge, no quad edge around v passes by p already, and every quad around v keeps its
+  // quality or stays at least snap_min_quality (see RelaxOptions::snap_reach); true if it moved.
+  auto snap_onto_feature = [&](int v) {
+    const Eigen::Vector3d old = q.V.row(v).transpose();
+    double h = 0;
+    for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
+    h /= static_cast<double>(neighbours[v].size());
+    const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
+    const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
+    if (!((p - old).norm() <= options.snap_reach * h)) return false;
+    double covered = std::numeric_limits<double>::infinity();
+    for (int f : vertex_quads[v])
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d a = q.V.row(q.vertex(f, k)).transpose();
+        const Eigen::Vector3d b = q.V.row(q.vertex(f, (k + 1) % 4)).transpose();
+        const Eigen::Vector3d ab = b - a;
+        const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+        covered = std::min(covered, (a + t * ab - p).norm());
+      }
+    if (covered <= kSnapCovered * h) return false;
+    std::vector<double> before;
+    for (int f : vertex_quads[v]) before.push_back(quad_quality(f));
+    q.V.row(v) = p.transpose();
+    bool keep = true;
+    for (size_t i = 0; i < before.size() && keep; ++i)
+      keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
+    if (!keep) q.V.row(v) = old.transpose();
+    return keep;
+  };
+  // Snapping, in vertex order; vertices of faces that are not quads stay (their shape is not
+  // checked).
   if (feature_tree && options.snap_reach > 0) {
-    // Vertices of faces that are not quads stay (their shape is not checked).
     std::vector<char> touches_polygon(nv, 0);
     for (int f = 0; f < nf; ++f)
       if (q.degree(f) != 4)
         for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
     for (int v = 0; v < nv; ++v) {
       if (fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v]) continue;
-      const Eigen::Vector3d old = q.V.row(v).transpose();
-      double h = 0;
-      for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
-      h /= static_cast<double>(neighbours[v].size());
-      const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
-      const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
-      if (!((p - old).norm() <= options.snap_reach * h)) continue;
-      // p already on an edge of the quads around v: the feature is met there.
-      double covered = std::numeric_limits<double>::infinity();
-      for (int f : vertex_quads[v])
-        for (int k = 0; k < 4; ++k) {
-          const Eigen::Vector3d a = q.V.row(q.vertex(f, k)).transpose();
-          const Eigen::Vector3d b = q.V.row(q.vertex(f, (k + 1) % 4)).transpose();
-          const Eigen::Vector3d ab = b - a;
-          const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-          covered = std::min(covered, (a + t * ab - p).norm());
-        }
-      if (covered <= kSnapCovered * h) continue;
-      // Every quad around v keeps its quality or stays at least snap_min_quality.
-      std::vector<double> before;
-      for (int f : vertex_quads[v]) before.push_back(quad_quality(f));
-      q.V.row(v) = p.transpose();
-      bool keep = true;
-      for (size_t i = 0; i < before.size() && keep; ++i)
-        keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
-      if (keep) {
+      if (snap_onto_feature(v)) {
         on_feature[v] = 1;
         ++res.stats.n_snapped;
-      } else {
-        q.V.row(v) = old.transpose();
       }
     }
   }
