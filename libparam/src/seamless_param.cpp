@@ -379,6 +379,27 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     out.stats.total_iterations += tr.iterations;
     out.stats.n_transition_iterations += tr.iterations;
     add_timers(tr.timers, &out.stats);
+    // Vertices within two rings of the faces that x leaves flipped.
+    auto near_flips = [&] {
+      std::vector<char> near(mesh.n_vertices(), 0);
+      for (int f = 0; f < mesh.n_faces(); ++f) {
+        const auto& fc = domain.face_copies[f];
+        if (core::orient2d(x.segment<2>(2 * fc[0]), x.segment<2>(2 * fc[1]), x.segment<2>(2 * fc[2])) <= 0)
+          for (int k = 0; k < 3; ++k) near[mesh.F(f, k)] = 1;
+      }
+      for (int ring = 0; ring < 2; ++ring) {
+        std::vector<char> grown = near;
+        for (int f = 0; f < mesh.n_faces(); ++f)
+          if (near[mesh.F(f, 0)] || near[mesh.F(f, 1)] || near[mesh.F(f, 2)])
+            grown[mesh.F(f, 0)] = grown[mesh.F(f, 1)] = grown[mesh.F(f, 2)] = 1;
+        near.swap(grown);
+      }
+      return near;
+    };
+    auto near_feature = [&](const std::vector<char>& near, int i) {
+      const int h = fs.halfedge[i];
+      return near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)];
+    };
     // A batch whose move fails with its features is redone: first without the features near the
     // faces that stayed flipped (two vertex rings), then without any of its features.
     for (int retry = 0; retry < 2 && elim_without_features && (!tr.status.is_ok() || tr.n_flipped > 0);
@@ -391,23 +412,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         if (last) disabled_reason[i] = kByFlips;
       };
       if (retry == 0) {
-        std::vector<char> near(mesh.n_vertices(), 0);
-        for (int f = 0; f < mesh.n_faces(); ++f) {
-          const auto& fc = domain.face_copies[f];
-          if (core::orient2d(x.segment<2>(2 * fc[0]), x.segment<2>(2 * fc[1]), x.segment<2>(2 * fc[2])) <= 0)
-            for (int k = 0; k < 3; ++k) near[mesh.F(f, k)] = 1;
-        }
-        for (int ring = 0; ring < 2; ++ring) {
-          std::vector<char> grown = near;
-          for (int f = 0; f < mesh.n_faces(); ++f)
-            if (near[mesh.F(f, 0)] || near[mesh.F(f, 1)] || near[mesh.F(f, 2)])
-              grown[mesh.F(f, 0)] = grown[mesh.F(f, 1)] = grown[mesh.F(f, 2)] = 1;
-          near.swap(grown);
-        }
+        const std::vector<char> near = near_flips();
         for (const int i : fbatch) {
           if (proposed[i] != 0 && proposed[i] != 1) continue;
-          const int h = fs.halfedge[i];
-          if (near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)])
+          if (near_feature(near, i))
             wait_or_disable(i);
           else
             ++n_kept;
@@ -430,6 +438,43 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       out.stats.n_transition_iterations += tr.iterations;
       add_timers(tr.timers, &out.stats);
       if (n_kept == 0) break;
+    }
+    // Still flipped without this batch's features: the features of earlier batches hold the
+    // layout there. Those near the faces left flipped are disabled and the batch is redone, then,
+    // if that is not enough, without any feature (rather than failing the component, which would
+    // then be parametrized again from the start without its features: crank's 11,610 creases).
+    for (int pass = 0; pass < 2 && !feature_rows.empty() && (!tr.status.is_ok() || tr.n_flipped > 0);
+         ++pass) {
+      const std::vector<char> near = pass == 0 ? near_flips() : std::vector<char>(mesh.n_vertices(), 1);
+      std::vector<char> in_batch(fs.size(), 0);
+      for (const int i : fbatch) in_batch[i] = 1;
+      int n_dropped = 0;
+      for (int i = 0; i < fs.size(); ++i) {
+        int& l = in_batch[i] ? proposed[i] : label[i];
+        if ((l == 0 || l == 1) && near_feature(near, i)) {
+          l = kDisabled;
+          disabled_reason[i] = kByFlips;
+          ++n_dropped;
+        }
+      }
+      if (n_dropped == 0) continue;
+      feature_rows.clear();
+      for (int i = 0; i < fs.size(); ++i)
+        if (!in_batch[i] && (label[i] == 0 || label[i] == 1))
+          feature_rows.push_back(feature_row(cut, fs.halfedge[i], label[i]));
+      elim = eliminate_seams(cut, matching);
+      for (const SparseRow& row : feature_rows) elim.add_row(row);
+      elim_without_features.reset();
+      new_rows.resize(n_seam_rows);
+      x = x_before;
+      batch_feature_rows.clear();
+      edge_sq = seam_edge_sq;
+      add_batch_features();
+      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300),
+                                 &x, n_copy_vars);
+      out.stats.total_iterations += tr.iterations;
+      out.stats.n_transition_iterations += tr.iterations;
+      add_timers(tr.timers, &out.stats);
     }
     for (const int i : fbatch) label[i] = proposed[i];
     feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
@@ -881,9 +926,11 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
         outs[c].stats.n_feature_edges == 0)
       return;
     const int n_features = outs[c].stats.n_feature_edges;
+    const std::string reason = outs[c].status.message();
     outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c], sub_direction[c]);
     outs[c].stats.n_feature_edges = n_features;
     outs[c].stats.n_disabled_features = n_features;
+    outs[c].stats.feature_fallback_reason = reason;
     fell_back[c] = 1;
   };
 #ifdef QUADIFY_WITH_TBB
@@ -912,6 +959,8 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
       result.features.push_back({sub_faces[c][fa.face], fa.corner, fa.constant_coord});
     st.n_feature_edges += o.stats.n_feature_edges;
     st.n_feature_fallbacks += fell_back[c];
+    if (fell_back[c] && st.feature_fallback_reason.empty())
+      st.feature_fallback_reason = o.stats.feature_fallback_reason;
     st.n_aligned_features += o.stats.n_aligned_features;
     st.n_disabled_features += o.stats.n_disabled_features;
     st.n_disabled_by_tau += o.stats.n_disabled_by_tau;

@@ -251,6 +251,8 @@ TEST_F(CliTest, SoftFeatureModeAlignsWithinTolerance) {
   EXPECT_EQ(f["aligned"], 12);
   EXPECT_EQ(f["disabled"], 0);
   EXPECT_EQ(f["disabled_by_tau"].get<int>() + f["disabled_by_wedge"].get<int>() + f["disabled_by_flips"].get<int>(), 0);
+  EXPECT_EQ(f["components_without_features"], 0);
+  EXPECT_EQ(f["fallback_reason"], "");
   EXPECT_LE(f["alignment_error"].get<double>(), 1e-5);
   const CliRun c = quadify("check '" + (dir_ / "c_uv.obj").string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
   ASSERT_EQ(c.exit_code, 0) << c.err;

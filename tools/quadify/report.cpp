@@ -225,8 +225,9 @@ void warn_feature_fallbacks(const std::string& input, const param::ParamStats& s
   if (quiet || stats.n_feature_fallbacks == 0) return;
   std::fprintf(stderr,
                "quadify: %s: %d of %d components could not be parametrized flip-free with their "
-               "features and were parametrized without them\n",
-               input.c_str(), stats.n_feature_fallbacks, stats.n_components);
+               "features and were parametrized without them (%s)\n",
+               input.c_str(), stats.n_feature_fallbacks, stats.n_components,
+               stats.feature_fallback_reason.c_str());
 }
 
 FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& input,
@@ -252,6 +253,7 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"disabled_by_flips", s.n_disabled_by_flips},
           {"patches", s.n_feature_patches},
           {"components_without_features", s.n_feature_fallbacks},
+          {"fallback_reason", s.feature_fallback_reason},
           {"alignment_error", number(s.feature_alignment_error)}};
 }
 
