@@ -400,6 +400,20 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       const int h = fs.halfedge[i];
       return near[mesh.F(h / 3, h % 3)] || near[mesh.F(h / 3, (h % 3 + 1) % 3)];
     };
+    // Redoes the batch's move from x_before with elim (the batch's features that are still
+    // proposed are added again).
+    auto redo_batch = [&] {
+      new_rows.resize(n_seam_rows);
+      x = x_before;
+      batch_feature_rows.clear();
+      edge_sq = seam_edge_sq;
+      add_batch_features();
+      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300),
+                                 &x, n_copy_vars);
+      out.stats.total_iterations += tr.iterations;
+      out.stats.n_transition_iterations += tr.iterations;
+      add_timers(tr.timers, &out.stats);
+    };
     // A batch whose move fails with its features is redone: first without the features near the
     // faces that stayed flipped (two vertex rings), then without any of its features.
     for (int retry = 0; retry < 2 && elim_without_features && (!tr.status.is_ok() || tr.n_flipped > 0);
@@ -427,27 +441,18 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         n_kept = 0;
       }
       elim = *elim_without_features;
-      new_rows.resize(n_seam_rows);
-      x = x_before;
-      batch_feature_rows.clear();
-      edge_sq = seam_edge_sq;
-      add_batch_features();
-      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300),
-                                 &x, n_copy_vars);
-      out.stats.total_iterations += tr.iterations;
-      out.stats.n_transition_iterations += tr.iterations;
-      add_timers(tr.timers, &out.stats);
+      redo_batch();
       if (n_kept == 0) break;
     }
     // Still flipped without this batch's features: the features of earlier batches hold the
     // layout there. Those near the faces left flipped are disabled and the batch is redone, then,
     // if that is not enough, without any feature (rather than failing the component, which would
     // then be parametrized again from the start without its features: crank's 11,610 creases).
+    std::vector<char> in_batch(fs.size(), 0);
+    for (const int i : fbatch) in_batch[i] = 1;
     for (int pass = 0; pass < 2 && !feature_rows.empty() && (!tr.status.is_ok() || tr.n_flipped > 0);
          ++pass) {
       const std::vector<char> near = pass == 0 ? near_flips() : std::vector<char>(mesh.n_vertices(), 1);
-      std::vector<char> in_batch(fs.size(), 0);
-      for (const int i : fbatch) in_batch[i] = 1;
       int n_dropped = 0;
       for (int i = 0; i < fs.size(); ++i) {
         int& l = in_batch[i] ? proposed[i] : label[i];
@@ -465,16 +470,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       elim = eliminate_seams(cut, matching);
       for (const SparseRow& row : feature_rows) elim.add_row(row);
       elim_without_features.reset();
-      new_rows.resize(n_seam_rows);
-      x = x_before;
-      batch_feature_rows.clear();
-      edge_sq = seam_edge_sq;
-      add_batch_features();
-      tr = move_into_constraints(domain, red, elim, new_rows, total_area / std::max(edge_sq, 1e-300),
-                                 &x, n_copy_vars);
-      out.stats.total_iterations += tr.iterations;
-      out.stats.n_transition_iterations += tr.iterations;
-      add_timers(tr.timers, &out.stats);
+      redo_batch();
     }
     for (const int i : fbatch) label[i] = proposed[i];
     feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
