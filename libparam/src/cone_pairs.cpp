@@ -72,14 +72,18 @@ struct PathSearch {
 std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
                                                                const CutMesh& cut,
                                                                const std::vector<int>& index,
-                                                               double max_length, int max_hops) {
+                                                               double max_length, int max_hops,
+                                                               const std::vector<char>& avoid) {
   std::vector<ConePairCancellation> result;
   if (!(max_length > 0) || max_hops < 1) return result;
   const int nv = mesh.n_vertices();
+  // Vertices no path may touch: the boundary and `avoid`.
   std::vector<char> on_boundary(nv, 0);
   for (int h = 0; h < 3 * mesh.n_faces(); ++h)
     if (cut.topo.twin[h] < 0)
       on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
+    if (avoid[v]) on_boundary[v] = 1;
   std::vector<std::vector<SeamStep>> adjacency(nv);
   for (int s = 0; s < static_cast<int>(cut.seams.size()); ++s) {
     const int f = cut.seams[s].he_a / 3, k = cut.seams[s].he_a % 3;

@@ -43,10 +43,13 @@ std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
 // joined by a path of at most max_hops seam edges and 3D length at most max_length whose inner
 // vertices are regular interior vertices; greedily by path length (shortest first, ties by
 // vertex ids: deterministic). Applying a pair moves one unit of index from the positive to the
-// negative cone, so cones of |index| > 1 may take part in several passes.
+// negative cone, so cones of |index| > 1 may take part in several passes. Vertices flagged in
+// `avoid` (#V, or empty) are neither ends nor inner vertices of a path (e.g. those of aligned
+// features, whose u/v labels follow the matchings across the seams they touch).
 std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
                                                                const CutMesh& cut,
                                                                const std::vector<int>& index,
-                                                               double max_length, int max_hops);
+                                                               double max_length, int max_hops,
+                                                               const std::vector<char>& avoid = {});
 
 }  // namespace quadify::param

@@ -1,6 +1,7 @@
 // Unit tests of libparam internals: cut + isometric unfold, matching measurement, constraint
 // elimination (copies only and in the seam-translation basis), energy derivatives, the layout
-// optimizer and local estimation.
+// optimizer, local estimation and the cone-pair search.
+#include "cone_pairs.h"
 #include "constraint_elimination.h"
 #include "cut_layout.h"
 #include "distortion_energy.h"
@@ -43,6 +44,41 @@ TEST(CutLayout, DualTreeCutIsADiskWithFPlus2Copies) {
   const CutMesh cut = cut_along_dual_tree(m, 0);
   EXPECT_EQ(cut.n_copies(), m.n_faces() + 2) << "a tree of triangles has F+2 vertices";
   EXPECT_EQ(static_cast<int>(cut.seams.size()), cut.topo.n_edges() - (m.n_faces() - 1));
+}
+
+// A +1 and a −1 cone at the ends of a seam edge pair up, unless one end is to be avoided (a
+// vertex of an aligned feature): then no path may start, end or pass there.
+TEST(ConePairs, PathsAvoidFlaggedVertices) {
+  const core::TriMesh m = test::make_icosphere(2);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  ASSERT_FALSE(cut.seams.empty());
+  const int f = cut.seams[0].he_a / 3, k = cut.seams[0].he_a % 3;
+  const int a = m.F(f, k), b = m.F(f, (k + 1) % 3);
+  std::vector<int> index(m.n_vertices(), 0);
+  index[a] = 1;
+  index[b] = -1;
+  const double far = 10;  // longer than any seam path of the unit sphere
+  const std::vector<ConePairCancellation> found = find_cone_pair_cancellations(m, cut, index, far, 1);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].positive_vertex, a);
+  EXPECT_EQ(found[0].negative_vertex, b);
+  ASSERT_EQ(found[0].changes.size(), 1u);
+  EXPECT_EQ(found[0].changes[0].seam, 0);
+  std::vector<char> avoid(m.n_vertices(), 0);
+  avoid[b] = 1;
+  EXPECT_TRUE(find_cone_pair_cancellations(m, cut, index, far, 3, avoid).empty());
+  // An avoided regular vertex: the direct pair stays, and no path of up to 3 seam edges runs
+  // through it.
+  avoid.assign(m.n_vertices(), 0);
+  const int c = a == 0 || b == 0 ? (a == 1 || b == 1 ? 2 : 1) : 0;
+  avoid[c] = 1;
+  const std::vector<ConePairCancellation> around = find_cone_pair_cancellations(m, cut, index, far, 3, avoid);
+  ASSERT_EQ(around.size(), 1u);
+  for (const SeamChange& ch : around[0].changes) {
+    const int g = cut.seams[ch.seam].he_a / 3, j = cut.seams[ch.seam].he_a % 3;
+    EXPECT_NE(m.F(g, j), c);
+    EXPECT_NE(m.F(g, (j + 1) % 3), c);
+  }
 }
 
 TEST(CutLayout, IsometricUnfoldHasUnitSingularValues) {
