@@ -520,97 +520,100 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         const int h = fs.halfedge[i];
         avoid[mesh.F(h / 3, h % 3)] = avoid[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
       }
-    for (int stage = 0; stage < 2; ++stage) {
-    if (stage == 1) {
-      if (out.stats.n_cancelled_pairs > 0 || failures == 0 || std::count(avoid.begin(), avoid.end(), 1) == 0)
-        break;
-      failures = 0;
-    }
-    for (int pass = 0; pass < kConePairPasses && failures < kMaxCancellationFailures; ++pass) {
-    const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
-        mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
-        options.cone_pair_max_hops, stage == 1 ? avoid : std::vector<char>{});
-    if (pairs.empty()) break;
-    const int cancelled_before = out.stats.n_cancelled_pairs;
-    const double tau_before = max_isometric_distortion(domain, x);
-    std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
-      if (begin >= end || failures >= kMaxCancellationFailures) return;
-      std::vector<int> new_matching = matching;
-      std::vector<char> changed(n_seams, 0);
-      for (size_t i = begin; i < end; ++i)
-        for (const SeamChange& ch : pairs[i].changes) {
-          new_matching[ch.seam] += ch.delta;
-          changed[ch.seam] = 1;
-        }
-      std::vector<int> kept_matching = matching;
-      for (int s = 0; s < n_seams; ++s)
-        if (changed[s]) kept_matching[s] = INT_MIN;
-      ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
-      for (const SparseRow& row : feature_rows) kept.add_row(row);
-      const Reduction kept_red = kept.reduction(x);
-      Eigen::VectorXd x_try = x;
-      ConstraintEliminator full = eliminate_seams(cut, new_matching);
-      for (const SparseRow& row : feature_rows) full.add_row(row);
-      std::vector<SparseRow> new_rows;
-      double edge_sq = 0;
-      for (int s = 0; s < n_seams; ++s)
-        if (changed[s]) {
-          for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s]))
-            new_rows.push_back(row);
-          edge_sq += seam_length(cut, s) * seam_length(cut, s);
-        }
-      TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows,
-                                                  total_area / edge_sq, &x_try, n_copy_vars,
-                                                  kCancellationPenaltyStages);
-      out.stats.total_iterations += tr.iterations;
-      out.stats.n_transition_iterations += tr.iterations;
-      add_timers(tr.timers, &out.stats);
-      bool ok = tr.status.is_ok() && tr.n_flipped == 0;
-      if (ok) {
-        Eigen::VectorXd y = tr.reduction.restrict(x_try);
-        OptimizeSettings st;
-        st.density = density;
-        st.power = power;
-        st.max_iterations = options.max_newton_iters;
-        st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
-        update_penalty_rows();
-        st.penalty_rows = penalty_rows;
-        st.penalty_weight = 1;
-        const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
-        out.stats.total_iterations += rep.iterations;
-        out.stats.n_batch_iterations += rep.iterations;
-        add_timers(rep.timers, &out.stats);
-        if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
-        // Flip-free is not enough: a face the move squashed to a sliver (dragon: τ 3·10⁷) passes
-        // the exact orientation test and leaves quantization no room.
-        ok = count_flipped(domain, x_try) == 0 &&
-             max_isometric_distortion(domain, x_try) <=
-                 std::max(kCancellationTauFloor, kCancellationTauGrowth * tau_before);
-        // With directions to follow, a set whose cones the field needs (its alignment gets
-        // worse) is kept: on an ellipsoid with anisotropic sizing, cancelling 9 pairs raised the
-        // map's angle to the principal directions from 5.7° to 14.4°.
-        if (ok && directions.size() > 0)
-          ok = direction_angle_mean(domain, directions, x_try) <=
-               direction_angle_mean(domain, directions, x) + kMaxCancellationAngleLoss;
+    // Passes of cancellation over the pairs whose paths avoid `avoid_vertices` (#V or empty).
+    auto cancel_passes = [&](const std::vector<char>& avoid_vertices) {
+      for (int pass = 0; pass < kConePairPasses && failures < kMaxCancellationFailures; ++pass) {
+        const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
+            mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
+            options.cone_pair_max_hops, avoid_vertices);
+        if (pairs.empty()) break;
+        const int cancelled_before = out.stats.n_cancelled_pairs;
+        const double tau_before = max_isometric_distortion(domain, x);
+        std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
+          if (begin >= end || failures >= kMaxCancellationFailures) return;
+          std::vector<int> new_matching = matching;
+          std::vector<char> changed(n_seams, 0);
+          for (size_t i = begin; i < end; ++i)
+            for (const SeamChange& ch : pairs[i].changes) {
+              new_matching[ch.seam] += ch.delta;
+              changed[ch.seam] = 1;
+            }
+          std::vector<int> kept_matching = matching;
+          for (int s = 0; s < n_seams; ++s)
+            if (changed[s]) kept_matching[s] = INT_MIN;
+          ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
+          for (const SparseRow& row : feature_rows) kept.add_row(row);
+          const Reduction kept_red = kept.reduction(x);
+          Eigen::VectorXd x_try = x;
+          ConstraintEliminator full = eliminate_seams(cut, new_matching);
+          for (const SparseRow& row : feature_rows) full.add_row(row);
+          std::vector<SparseRow> new_rows;
+          double edge_sq = 0;
+          for (int s = 0; s < n_seams; ++s)
+            if (changed[s]) {
+              for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s]))
+                new_rows.push_back(row);
+              edge_sq += seam_length(cut, s) * seam_length(cut, s);
+            }
+          TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows,
+                                                      total_area / edge_sq, &x_try, n_copy_vars,
+                                                      kCancellationPenaltyStages);
+          out.stats.total_iterations += tr.iterations;
+          out.stats.n_transition_iterations += tr.iterations;
+          add_timers(tr.timers, &out.stats);
+          bool ok = tr.status.is_ok() && tr.n_flipped == 0;
+          if (ok) {
+            Eigen::VectorXd y = tr.reduction.restrict(x_try);
+            OptimizeSettings st;
+            st.density = density;
+            st.power = power;
+            st.max_iterations = options.max_newton_iters;
+            st.relative_tolerance =
+                options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
+            update_penalty_rows();
+            st.penalty_rows = penalty_rows;
+            st.penalty_weight = 1;
+            const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
+            out.stats.total_iterations += rep.iterations;
+            out.stats.n_batch_iterations += rep.iterations;
+            add_timers(rep.timers, &out.stats);
+            if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
+            // Flip-free is not enough: a face the move squashed to a sliver (dragon: τ 3·10⁷)
+            // passes the exact orientation test and leaves quantization no room.
+            ok = count_flipped(domain, x_try) == 0 &&
+                 max_isometric_distortion(domain, x_try) <=
+                     std::max(kCancellationTauFloor, kCancellationTauGrowth * tau_before);
+            // With directions to follow, a set whose cones the field needs (its alignment gets
+            // worse) is kept: on an ellipsoid with anisotropic sizing, cancelling 9 pairs raised
+            // the map's angle to the principal directions from 5.7° to 14.4°.
+            if (ok && directions.size() > 0)
+              ok = direction_angle_mean(domain, directions, x_try) <=
+                   direction_angle_mean(domain, directions, x) + kMaxCancellationAngleLoss;
+          }
+          if (ok) {
+            matching = std::move(new_matching);
+            elim = std::move(full);
+            red_problem.reset();
+            red = std::move(tr.reduction);
+            x = std::move(x_try);
+            out.stats.n_cancelled_pairs += static_cast<int>(end - begin);
+            return;
+          }
+          ++failures;
+          if (end - begin < 2) return;
+          const size_t mid = begin + (end - begin) / 2;
+          apply(begin, mid);
+          apply(mid, end);
+        };
+        apply(0, pairs.size());
+        if (out.stats.n_cancelled_pairs == cancelled_before) break;
       }
-      if (ok) {
-        matching = std::move(new_matching);
-        elim = std::move(full);
-        red_problem.reset();
-        red = std::move(tr.reduction);
-        x = std::move(x_try);
-        out.stats.n_cancelled_pairs += static_cast<int>(end - begin);
-        return;
-      }
-      ++failures;
-      if (end - begin < 2) return;
-      const size_t mid = begin + (end - begin) / 2;
-      apply(begin, mid);
-      apply(mid, end);
     };
-    apply(0, pairs.size());
-    if (out.stats.n_cancelled_pairs == cancelled_before) break;
-    }
+    cancel_passes({});
+    if (out.stats.n_cancelled_pairs == 0 && failures > 0 &&
+        std::count(avoid.begin(), avoid.end(), 1) > 0) {
+      failures = 0;
+      cancel_passes(avoid);
     }
     out.stats.seconds_optimize += seconds_since(to);
   }
