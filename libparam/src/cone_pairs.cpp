@@ -6,15 +6,24 @@
 #include <tuple>
 
 namespace quadify::param {
+namespace {
+
+// Vertices on the mesh boundary (#V flags).
+std::vector<char> boundary_vertices(const core::TriMesh& mesh, const CutMesh& cut) {
+  std::vector<char> on_boundary(mesh.n_vertices(), 0);
+  for (int h = 0; h < 3 * mesh.n_faces(); ++h)
+    if (cut.topo.twin[h] < 0)
+      on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  return on_boundary;
+}
+
+}  // namespace
 
 std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
                                 const Eigen::VectorXd& x) {
   const int nv = mesh.n_vertices(), nf = mesh.n_faces();
   std::vector<double> angle_sum(nv, 0.0);
-  std::vector<char> on_boundary(nv, 0);
-  for (int h = 0; h < 3 * nf; ++h)
-    if (cut.topo.twin[h] < 0)
-      on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  const std::vector<char> on_boundary = boundary_vertices(mesh, cut);
   for (int f = 0; f < nf; ++f)
     for (int k = 0; k < 3; ++k) {
       const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
@@ -41,7 +50,7 @@ struct SeamStep {
 struct PathSearch {
   const std::vector<std::vector<SeamStep>>& adjacency;
   const std::vector<int>& index;
-  const std::vector<char>& on_boundary;
+  const std::vector<char>& excluded;  // vertices no path may touch
   double max_length;
   int max_hops;
   int source;
@@ -52,7 +61,7 @@ struct PathSearch {
   void extend(int v, double length) {
     for (const SeamStep& st : adjacency[v]) {
       const double l = length + st.length;
-      if (l > max_length || on_boundary[st.to]) continue;
+      if (l > max_length || excluded[st.to]) continue;
       if (std::find(visited.begin(), visited.end(), st.to) != visited.end()) continue;
       path.push_back({st.seam, st.orientation});
       if (index[st.to] < 0) {
@@ -78,12 +87,9 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
   if (!(max_length > 0) || max_hops < 1) return result;
   const int nv = mesh.n_vertices();
   // Vertices no path may touch: the boundary and `avoid`.
-  std::vector<char> on_boundary(nv, 0);
-  for (int h = 0; h < 3 * mesh.n_faces(); ++h)
-    if (cut.topo.twin[h] < 0)
-      on_boundary[mesh.F(h / 3, h % 3)] = on_boundary[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+  std::vector<char> excluded = boundary_vertices(mesh, cut);
   for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
-    if (avoid[v]) on_boundary[v] = 1;
+    if (avoid[v]) excluded[v] = 1;
   std::vector<std::vector<SeamStep>> adjacency(nv);
   for (int s = 0; s < static_cast<int>(cut.seams.size()); ++s) {
     const int f = cut.seams[s].he_a / 3, k = cut.seams[s].he_a % 3;
@@ -94,8 +100,8 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
   }
   std::vector<ConePairCancellation> candidates;
   for (int p = 0; p < nv; ++p) {
-    if (index[p] <= 0 || on_boundary[p]) continue;
-    PathSearch search{adjacency, index, on_boundary, max_length, max_hops, p, {}, {p}, &candidates};
+    if (index[p] <= 0 || excluded[p]) continue;
+    PathSearch search{adjacency, index, excluded, max_length, max_hops, p, {}, {p}, &candidates};
     search.extend(p, 0.0);
   }
   std::sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
