@@ -128,9 +128,13 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     features_dropped = true;
     features_dropped_reason = integer_map.stats.features_dropped_reason;
     if (!common.quiet)
-      std::fprintf(stderr, "quadify: %s: the aligned features do not fit the quad grid at this density (%s); "
-                           "remeshing without them (a larger --target-faces may keep them)\n",
-                   args.input.c_str(), integer_map.stats.features_dropped_reason.c_str());
+      std::fprintf(stderr,
+                   "quadify: %s: the aligned features do not fit the quad grid at this density (%s; "
+                   "%.0f s spent on them); remeshing without them (a larger --target-faces may keep "
+                   "them, --feature-angle 0%s skips them from the start)\n",
+                   args.input.c_str(), integer_map.stats.features_dropped_reason.c_str(),
+                   seamless.stats.seconds_total + integer_map.stats.seconds,
+                   core::topology_stats(mesh).n_boundary_loops > 0 ? " --no-boundary-alignment" : "");
     param_options.feature_edges.clear();
     param_options.align_boundaries = false;
     seamless = parametrize(param_options);
