@@ -12,6 +12,19 @@ namespace {
 // Newton iterations of a patch layout (patches are small and start near their optimum).
 constexpr int kPatchIterations = 20;
 constexpr double kPatchTolerance = 1e-6;
+// Two patch distortions closer than this (relative) are a tie: the patch solves stop at
+// kPatchTolerance, so smaller differences are round-off (e.g. a patch that turns freely).
+constexpr double kTieTolerance = 10 * kPatchTolerance;
+
+// 0 or 1: the alternative with clearly lower distortion; -1: a tie (both failed, or equal
+// within kTieTolerance).
+int lower_distortion(double d0, double d1) {
+  if (!(d0 < d1) && !(d1 < d0)) return -1;
+  if (std::isfinite(d0) && std::isfinite(d1) &&
+      std::abs(d0 - d1) <= kTieTolerance * std::max(std::abs(d0), std::abs(d1)))
+    return -1;
+  return d0 < d1 ? 0 : 1;
+}
 
 }  // namespace
 
@@ -193,12 +206,10 @@ FeatureChoice LocalEstimator::choose_feature(int feature, const std::vector<int>
     choice.distortion[c] = a.energy[c];
     choice.tau[c] = a.tau[c];
   }
-  if (choice.distortion[0] < choice.distortion[1])
-    choice.label = 0;
-  else if (choice.distortion[1] < choice.distortion[0])
-    choice.label = 1;
-  else
-    choice.label = nearest_label(feature_measure(cut_, x, h));
+  // A patch that only this edge's row holds can turn freely: both labels then cost the same
+  // (up to round-off), and the edge takes its nearest axis, the smaller turn.
+  const int better = lower_distortion(choice.distortion[0], choice.distortion[1]);
+  choice.label = better < 0 ? nearest_label(feature_measure(cut_, x, h)) : better;
   return choice;
 }
 

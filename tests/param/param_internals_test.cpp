@@ -437,6 +437,35 @@ TEST(FeatureAlignment, WedgeCheckUsesTheChosenAxisNotTheNearest) {
   EXPECT_TRUE(r.relabeled.empty()) << "a straight continuation is a label switch, not a coin toss";
 }
 
+TEST(LocalEstimation, AFeatureWhosePatchTurnsFreelyTakesItsNearestAxis) {
+  // A lone spoke of a flat disk, the layout turned so that it points 0.3 to 0.45 of a quarter
+  // turn off an axis (local estimation runs from 0.3 on). Its patch holds no other row, so it
+  // turns rigidly onto either axis at the same distortion: a tie, which must go to the nearest
+  // axis (the smaller turn), not to whichever side round-off favours.
+  const core::TriMesh mesh = test::make_disk(4, 12);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  const LayoutDomain dom = make_domain(cut);
+  const Eigen::VectorXd x0 = flatten(isometric_unfold(mesh, cut));
+  const std::vector<int> spokes = disk_spokes(cut, 6);
+  ASSERT_GE(spokes[0], 0);
+  const FeatureSet fs = make_feature_set(cut, {spokes[0]});
+  const LocalEstimator est(mesh, cut, dom, 5, &fs);
+  const std::vector<int> rounded(cut.seams.size(), INT_MIN);
+  const std::vector<int> labels(1, kUnlabeled);
+  for (const double target : {0.3, 0.35, 0.4, 0.45, 0.55, 0.6, 0.65, 0.7, -0.35, 1.4, -1.6}) {
+    Eigen::VectorXd x = x0;
+    const double turn = (target - feature_measure(cut, x, fs.halfedge[0])) * std::numbers::pi / 2;
+    const Eigen::Matrix2d R = Eigen::Rotation2Dd(turn).toRotationMatrix();
+    for (int c = 0; c < x.size() / 2; ++c) x.segment<2>(2 * c) = R * x.segment<2>(2 * c);
+    const double measure = feature_measure(cut, x, fs.halfedge[0]);
+    ASSERT_NEAR(measure, target, 1e-9);
+    const FeatureChoice fc = est.choose_feature(0, rounded, labels, x, Density::kSymmetricDirichlet, 1);
+    ASSERT_TRUE(std::isfinite(fc.distortion[0]) && std::isfinite(fc.distortion[1]));
+    EXPECT_NEAR(fc.distortion[0], fc.distortion[1], 1e-6 * fc.distortion[0]) << "a rigid turn costs nothing";
+    EXPECT_EQ(fc.label, nearest_label(measure)) << "at " << target << " quarter turns";
+  }
+}
+
 TEST(FeatureAlignment, WedgeCheckGivesACornerFeatureNear45DegreesItsOtherAxis) {
   // Two spokes at 90° on the surface, the layout turned so that they lie at 40° and 130° from u.
   // Labeled by their nearest axes they make a corner; if the second gets the first's axis (a coin
