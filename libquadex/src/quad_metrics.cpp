@@ -5,6 +5,7 @@
 #include <libcore/predicates.h>
 #include <libcore/topology.h>
 
+#include "parallel.h"
 #include "quad_corners.h"
 
 #include <CGAL/AABB_segment_primitive.h>
@@ -14,10 +15,6 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <Eigen/Geometry>
 
-#ifdef QUADIFY_WITH_TBB
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -48,19 +45,6 @@ constexpr double kFeatureSampleSpacing = 1e-3;
 
 Point to_point(const Eigen::Vector3d& p) { return Point(p.x(), p.y(), p.z()); }
 Eigen::Vector3d to_eigen(const Point& p) { return {p.x(), p.y(), p.z()}; }
-
-// Runs body(i) for i in [0, n), in parallel when TBB is available. Each i writes only its own
-// output slot, so the result does not depend on the scheduling.
-template <class Body>
-void parallel_for_each_index(size_t n, const Body& body) {
-#ifdef QUADIFY_WITH_TBB
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) body(i);
-  });
-#else
-  for (size_t i = 0; i < n; ++i) body(i);
-#endif
-}
 
 struct DisjointSets {
   std::vector<int> parent;

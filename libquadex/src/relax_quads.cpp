@@ -2,6 +2,7 @@
 
 #include <libcore/predicates.h>
 
+#include "parallel.h"
 #include "quad_corners.h"
 
 #include <Eigen/Geometry>
@@ -17,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <tuple>
 #include <vector>
 
 namespace quadify::quadex {
@@ -44,6 +46,17 @@ constexpr double kHalfStep = 0.5;
 constexpr double kIntoQuadSteps[] = {0.3, 0.1};
 // A move is kept when it raises the local worst scaled Jacobian by more than this (round-off).
 constexpr double kMinImprovement = 1e-9;
+// Shape fitting: samples per quad triangle side (a barycentric grid of (n+1)(n+2)/2 points) for
+// the distance from a quad to the surface.
+constexpr int kFitQuadSamples = 4;
+// Candidate positions of a vertex: surface samples under its quads within this (× its mean quad
+// edge length) of it.
+constexpr double kFitReach = 0.5;
+// Of those, at most this many are tried: the farthest from the quads (a cut-off tip or ridge is
+// among them), and three times as many picked evenly from the rest.
+constexpr size_t kFitFarthest = 16, kFitSpread = 48;
+// A fitting move is kept when it lowers the local distance by more than this (× diagonal).
+constexpr double kFitMinGain = 1e-9;
 
 }  // namespace
 
@@ -53,10 +66,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   RelaxResult res;
   res.quads = quads;
   if (!(options.min_scaled_jacobian <= 1) || options.max_rounds < 0 || options.rings < 0 ||
-      !(options.snap_reach >= 0) || !(options.snap_min_quality <= 1)) {
+      !(options.snap_reach >= 0) || !(options.snap_min_quality <= 1) ||
+      !(options.fit_fraction >= 0) || !(options.fit_min_quality <= 1) || options.fit_rounds < 0) {
     res.status = core::Status::invalid_input(
         "relax options: need min_scaled_jacobian ≤ 1, max_rounds ≥ 0, rings ≥ 0, snap_reach ≥ 0, "
-        "snap_min_quality ≤ 1");
+        "snap_min_quality ≤ 1, fit_fraction ≥ 0, fit_min_quality ≤ 1, fit_rounds ≥ 0");
     return res;
   }
   const int nv = quads.n_vertices(), nf = quads.n_faces();
@@ -245,6 +259,182 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     if (!keep) q.V.row(v) = old.transpose();
     return keep;
   };
+  // Shape fitting (see RelaxOptions::fit_fraction). The quads are measured as two triangles each,
+  // (0,1,2) and (0,2,3), as core::to_trimesh and the metrics split them. Surface samples (the
+  // vertices and three interior points per triangle) are owned by their closest quad at the start
+  // of a round; a vertex's local distance is the largest of its quads' distances to the surface
+  // (barycentric grid samples) and of its owned samples' distances to its quads.
+  auto fit_to_surface = [&](const std::vector<char>& frozen) {
+    const double diag = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
+    std::vector<Eigen::Vector3d> samples;
+    {
+      std::vector<char> used(surface.n_vertices(), 0);
+      for (int f = 0; f < surface.n_faces(); ++f)
+        for (int k = 0; k < 3; ++k) used[surface.F(f, k)] = 1;
+      for (int v = 0; v < surface.n_vertices(); ++v)
+        if (used[v]) samples.push_back(surface.V.row(v).transpose());
+      for (const Triangle& t : triangles)
+        for (int k = 0; k < 3; ++k) {
+          const Point p = CGAL::barycenter(t[k], 4.0, t[(k + 1) % 3], 1.0, t[(k + 2) % 3], 1.0);
+          samples.emplace_back(p.x(), p.y(), p.z());
+        }
+    }
+    const int ns = static_cast<int>(samples.size());
+    auto quad_triangle = [&](int f, int t) {
+      const int k = t == 0 ? 1 : 2;
+      auto pt = [&](int j) { return Point(q.V(q.vertex(f, j), 0), q.V(q.vertex(f, j), 1), q.V(q.vertex(f, j), 2)); };
+      return Triangle(pt(0), pt(k), pt(k + 1));
+    };
+    // Largest distance from quad f's samples to the surface.
+    auto quad_distance = [&](int f) {
+      double worst = 0;
+      for (int t = 0; t < 2; ++t) {
+        const Triangle tri = quad_triangle(f, t);
+        for (int i = 0; i <= kFitQuadSamples; ++i)
+          for (int j = 0; i + j <= kFitQuadSamples; ++j) {
+            const double a = static_cast<double>(i) / kFitQuadSamples, b = static_cast<double>(j) / kFitQuadSamples;
+            const Point p = CGAL::barycenter(tri[0], 1 - a - b, tri[1], a, tri[2], b);
+            worst = std::max(worst, tree.squared_distance(p));
+          }
+      }
+      return std::sqrt(worst);
+    };
+    // Distance from a sample to quad f.
+    auto sample_distance = [&](int s, int f) {
+      const Point p(samples[s].x(), samples[s].y(), samples[s].z());
+      return std::sqrt(std::min(CGAL::squared_distance(p, quad_triangle(f, 0)),
+                                CGAL::squared_distance(p, quad_triangle(f, 1))));
+    };
+    std::vector<double> quad_dist(nf, 0), sample_dist(ns, 0);
+    std::vector<int> owner(ns, -1);
+    double threshold = 0;  // local distances above it are fitted
+    for (int round = 0; round < options.fit_rounds; ++round) {
+      std::vector<Triangle> quad_tris;
+      std::vector<int> quad_of;
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4)
+          for (int t = 0; t < 2; ++t) {
+            quad_tris.push_back(quad_triangle(f, t));
+            quad_of.push_back(f);
+          }
+      if (quad_tris.empty()) return;
+      TriangleTree quad_tree(quad_tris.begin(), quad_tris.end());
+      quad_tree.accelerate_distance_queries();
+      parallel_for_each_index(static_cast<size_t>(ns), [&](size_t s) {
+        const Point p(samples[s].x(), samples[s].y(), samples[s].z());
+        const auto hit = quad_tree.closest_point_and_primitive(p);
+        owner[s] = quad_of[static_cast<size_t>(hit.second - quad_tris.cbegin())];
+        sample_dist[s] = std::sqrt(CGAL::squared_distance(p, hit.first));
+      });
+      parallel_for_each_index(static_cast<size_t>(nf), [&](size_t f) {
+        quad_dist[f] = q.degree(static_cast<int>(f)) == 4 ? quad_distance(static_cast<int>(f)) : 0.0;
+      });
+      std::vector<std::vector<int>> owned(nf);
+      for (int s = 0; s < ns; ++s) owned[owner[s]].push_back(s);
+      // v's local distance and where it is reached (a sample, or the centroid of a quad).
+      auto local_distance_at = [&](int v) {
+        double d = 0;
+        Eigen::Vector3d where = q.V.row(v).transpose();
+        for (int f : vertex_quads[v]) {
+          if (quad_dist[f] > d) {
+            d = quad_dist[f];
+            where = quad_corners(q, f).centroid();
+          }
+          for (int s : owned[f])
+            if (sample_dist[s] > d) {
+              d = sample_dist[s];
+              where = samples[s];
+            }
+        }
+        return std::make_pair(d, where);
+      };
+      auto local_distance = [&](int v) { return local_distance_at(v).first; };
+      if (round == 0) {
+        double largest = 0;
+        for (int f = 0; f < nf; ++f) largest = std::max(largest, quad_dist[f]);
+        for (int s = 0; s < ns; ++s) largest = std::max(largest, sample_dist[s]);
+        res.stats.fit_distance_before = largest / diag;
+        threshold = options.fit_fraction * largest;
+      }
+      // Farthest first; among vertices sharing their worst point (the four of a quad), the
+      // nearest to it first.
+      std::vector<std::tuple<double, double, int>> todo;
+      for (int v = 0; v < nv; ++v)
+        if (!frozen[v]) {
+          const auto [d, where] = local_distance_at(v);
+          if (d > threshold) todo.emplace_back(-d, (where - q.V.row(v).transpose()).norm(), v);
+        }
+      std::sort(todo.begin(), todo.end());
+      int moves = 0;
+      for (const auto& [neg_d, gap, v] : todo) {
+        const Eigen::Vector3d old = q.V.row(v).transpose();
+        double h = 0;
+        for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
+        h /= static_cast<double>(neighbours[v].size());
+        std::vector<int> mine;
+        for (int f : vertex_quads[v]) mine.insert(mine.end(), owned[f].begin(), owned[f].end());
+        std::vector<double> quality;
+        for (int f : vertex_quads[v]) quality.push_back(quad_quality(f));
+        // The local distance with v at its current position, or any value ≥ bound once it
+        // reaches bound.
+        auto evaluate = [&](double bound) {
+          double d = 0;
+          for (int f : vertex_quads[v]) {
+            d = std::max(d, quad_distance(f));
+            if (d >= bound) return d;
+          }
+          for (int s : mine) {
+            double ds = std::numeric_limits<double>::infinity();
+            for (int f : vertex_quads[v]) ds = std::min(ds, sample_distance(s, f));
+            d = std::max(d, ds);
+            if (d >= bound) return d;
+          }
+          return d;
+        };
+        std::vector<std::pair<double, int>> candidates;
+        for (int s : mine)
+          if ((samples[s] - old).norm() <= kFitReach * h) candidates.emplace_back(-sample_dist[s], s);
+        if (candidates.size() > kFitFarthest + kFitSpread) {
+          std::partial_sort(candidates.begin(), candidates.begin() + kFitFarthest, candidates.end());
+          const size_t rest = candidates.size() - kFitFarthest;
+          for (size_t i = 0; i < kFitSpread; ++i)
+            candidates[kFitFarthest + i] = candidates[kFitFarthest + i * rest / kFitSpread];
+          candidates.resize(kFitFarthest + kFitSpread);
+        }
+        const double current = local_distance(v);
+        double best = current;
+        int best_sample = -1;
+        for (const auto& [neg_ds, s] : candidates) {
+          q.V.row(v) = samples[s].transpose();
+          bool ok = true;
+          for (size_t i = 0; i < quality.size() && ok; ++i)
+            ok = quad_quality(vertex_quads[v][i]) >= std::min(quality[i], options.fit_min_quality);
+          if (!ok) continue;
+          const double d = evaluate(best - kFitMinGain * diag);
+          if (d < best - kFitMinGain * diag) {
+            best = d;
+            best_sample = s;
+          }
+        }
+        q.V.row(v) = old.transpose();
+        if (best_sample < 0) continue;
+        q.V.row(v) = samples[best_sample].transpose();
+        ++moves;
+        for (int f : vertex_quads[v]) quad_dist[f] = quad_distance(f);
+        for (int s : mine) {
+          double ds = std::numeric_limits<double>::infinity();
+          for (int f : vertex_quads[v]) ds = std::min(ds, sample_distance(s, f));
+          sample_dist[s] = ds;
+        }
+      }
+      res.stats.n_fitted += moves;
+      double after = 0;
+      for (int f = 0; f < nf; ++f) after = std::max(after, quad_dist[f]);
+      for (int s = 0; s < ns; ++s) after = std::max(after, sample_dist[s]);
+      res.stats.fit_distance_after = after / diag;
+      if (moves == 0) break;
+    }
+  };
   // Snapping, in vertex order; vertices of faces that are not quads stay (their shape is not
   // checked).
   if (feature_tree && options.snap_reach > 0) {
@@ -280,6 +470,14 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     res.stats.n_moves += relax_rounds(frozen, kFlipped);
     for (int v = 0; v < nv; ++v)
       if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
+  }
+  if (options.fit_fraction > 0 && options.fit_rounds > 0) {
+    std::vector<char> fit_frozen(nv, 0);
+    for (int v = 0; v < nv; ++v) fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v];
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) != 4)
+        for (int k = 0; k < q.degree(f); ++k) fit_frozen[q.vertex(f, k)] = 1;
+    fit_to_surface(fit_frozen);
   }
   res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
   res.stats.n_flipped_after = count_bad(kFlipped);

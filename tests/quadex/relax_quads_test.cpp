@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace quadify::quadex {
@@ -182,10 +184,89 @@ TEST(RelaxQuads, SnapsTheRowNextToAMissedCreaseOntoIt) {
     EXPECT_NEAR(r.quads.V(v, 2), 1.0, 1e-12) << "vertex " << v << " is not on the crease";
   }
   for (int v = 0; v < q.n_vertices(); ++v)
-    if (v / (columns + 1) != 2) EXPECT_EQ(r.quads.V.row(v), q.V.row(v)) << "vertex " << v << " moved";
+    if (v / (columns + 1) != 2) {
+      EXPECT_EQ(r.quads.V.row(v), q.V.row(v)) << "vertex " << v << " moved";
+    }
   const QuadMetrics m = compute_quad_metrics(r.quads, &surface);
   EXPECT_EQ(m.n_flipped, 0);
   EXPECT_GT(m.sj_min, 0.9) << "only the quads at the fixed boundary columns are not rectangles";
+}
+
+// The square [0, n]² as a grid of cells of side 1/k (two triangles each) lifted by a cone of
+// height 0.6 and radius 1 whose apex, a grid vertex, is at `apex`.
+constexpr double kBumpHeight = 0.6;
+double bump(const Eigen::Vector2d& p, const Eigen::Vector2d& apex) {
+  return kBumpHeight * std::max(0.0, 1 - (p - apex).norm());
+}
+core::TriMesh bumped_square(int n, int k, const Eigen::Vector2d& apex) {
+  const int m = n * k;
+  core::TriMesh t;
+  t.V.resize((m + 1) * (m + 1), 3);
+  for (int j = 0; j <= m; ++j)
+    for (int i = 0; i <= m; ++i) {
+      const Eigen::Vector2d p(static_cast<double>(i) / k, static_cast<double>(j) / k);
+      t.V.row(j * (m + 1) + i) << p.x(), p.y(), bump(p, apex);
+    }
+  t.F.resize(2 * m * m, 3);
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) {
+      const int a = j * (m + 1) + i;
+      t.F.row(2 * (j * m + i)) << a, a + 1, a + m + 2;
+      t.F.row(2 * (j * m + i) + 1) << a, a + m + 2, a + m + 1;
+    }
+  return t;
+}
+// The height of bumped_square(·, k, ·) over (x, y): its piecewise-linear interpolation.
+double bumped_height(double x, double y, int k, const Eigen::Vector2d& apex) {
+  const double i = std::floor(x * k), j = std::floor(y * k);
+  const double u = x * k - i, w = y * k - j;
+  auto h = [&](double a, double b) { return bump(Eigen::Vector2d(a / k, b / k), apex); };
+  return u >= w ? h(i, j) + u * (h(i + 1, j) - h(i, j)) + w * (h(i + 1, j + 1) - h(i + 1, j))
+                : h(i, j) + w * (h(i, j + 1) - h(i, j)) + u * (h(i + 1, j + 1) - h(i, j + 1));
+}
+
+TEST(RelaxQuads, FittingBringsInATipTheQuadsCutOff) {
+  // A 4×4 grid of unit quads on a square with a cone-shaped bump whose apex (2.2, 1.9) lies
+  // inside a quad of vertex (2, 2): the quads cut the tip off. The fitting must move that vertex
+  // onto the apex (the surface vertex there), lower the distance between the quads and the
+  // surface (the bump is as wide as a quad, so its flanks stay cut), keep every vertex on the
+  // surface and every corner good, and leave the boundary alone; with fitting off, nothing moves
+  // (the grid's quads are all good).
+  const int n = 4, k = 10;
+  const Eigen::Vector2d apex(2.2, 1.9);
+  const core::TriMesh surface = bumped_square(n, k, apex);
+  core::PolyMesh q = grid(n);
+  for (int v = 0; v < q.n_vertices(); ++v) q.V(v, 2) = bump(q.V.row(v).head<2>().transpose(), apex);
+  const QuadMetrics before = compute_quad_metrics(q, &surface);
+  ASSERT_GT(before.hausdorff_sym, 0.02);  // × bounding-box diagonal (5.7)
+
+  RelaxOptions off;
+  off.fit_fraction = 0;
+  const RelaxResult kept = relax_bad_quads(q, surface, off);
+  ASSERT_TRUE(kept.status.is_ok()) << kept.status.to_string();
+  EXPECT_EQ(kept.stats.n_fitted, 0);
+  EXPECT_EQ(kept.quads.V, q.V);
+
+  const RelaxResult r = relax_bad_quads(q, surface);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_GE(r.stats.n_fitted, 1);
+  EXPECT_LT(r.stats.fit_distance_after, 0.9 * r.stats.fit_distance_before);
+  const QuadMetrics after = compute_quad_metrics(r.quads, &surface);
+  EXPECT_LT(after.hausdorff_sym, 0.9 * before.hausdorff_sym);
+  EXPECT_EQ(after.n_flipped, 0);
+  EXPECT_GE(after.sj_min, 0.5);
+  const int centre = 2 * (n + 1) + 2;
+  EXPECT_LT((r.quads.V.row(centre).transpose() - Eigen::Vector3d(apex.x(), apex.y(), kBumpHeight)).norm(), 1e-12)
+      << "the vertex next to the apex is at " << r.quads.V.row(centre);
+  for (int v = 0; v < q.n_vertices(); ++v) {
+    EXPECT_NEAR(r.quads.V(v, 2), bumped_height(r.quads.V(v, 0), r.quads.V(v, 1), k, apex), 1e-9)
+        << "vertex " << v << " left the surface";
+    const int i = v % (n + 1), j = v / (n + 1);
+    if (i == 0 || j == 0 || i == n || j == n) {
+      EXPECT_EQ(r.quads.V.row(v), q.V.row(v)) << "boundary vertex " << v << " moved";
+    }
+  }
+  EXPECT_EQ(r.quads.face_vertex, q.face_vertex);
 }
 
 TEST(RelaxQuads, RejectsBadInput) {

@@ -29,6 +29,7 @@ struct RemeshArgs {
   bool measure = true;
   bool relax = true;
   bool feature_snap = true;
+  bool fit = true;
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
@@ -191,6 +192,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     quadex::RelaxOptions relax_options;
     relax_options.feature_edges = param_options.feature_edges;
     if (!args.feature_snap) relax_options.snap_reach = 0;
+    if (!args.fit) relax_options.fit_fraction = 0;
     quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh, relax_options);
     progress.end();
     if (!relaxed.status.is_ok())
@@ -253,6 +255,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"moves", relax_stats.n_moves},
                        {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
                        {"snapped", relax_stats.n_snapped},
+                       {"fitted", relax_stats.n_fitted},
+                       {"fit_distance_before", relax_stats.fit_distance_before},
+                       {"fit_distance_after", relax_stats.fit_distance_after},
                        {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");
@@ -346,6 +351,11 @@ CommandRunner register_remesh(CLI::App& app) {
   app.add_flag("!--no-feature-snap", args->feature_snap,
                "Do not move quad vertices onto a nearby feature curve that their quads cut off (by "
                "default, part of the relaxation; see relax.snapped in the report)");
+  app.add_flag("!--no-fit", args->fit,
+               "Do not move quad vertices where the quads are farthest from the input (by default, part "
+               "of the relaxation: a vertex whose quads deviate by more than 0.8 of the largest "
+               "deviation moves to the input surface point under them that lowers it most, keeping "
+               "its quads' corners; see relax.fitted and relax.fit_distance_* in the report)");
   app.add_flag("!--no-measure", args->measure,
                "Skip the quality measures (Hausdorff distance, scaled Jacobian) of the report");
   app.add_option("--samples", args->samples, "Area samples per surface for the Hausdorff distance")
