@@ -280,10 +280,10 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         }
     }
     const int ns = static_cast<int>(samples.size());
+    // Triangle t of face f's fan (0, t+1, t+2): for a quad (0,1,2) and (0,2,3).
     auto quad_triangle = [&](int f, int t) {
-      const int k = t == 0 ? 1 : 2;
       auto pt = [&](int j) { return Point(q.V(q.vertex(f, j), 0), q.V(q.vertex(f, j), 1), q.V(q.vertex(f, j), 2)); };
-      return Triangle(pt(0), pt(k), pt(k + 1));
+      return Triangle(pt(0), pt(t + 1), pt(t + 2));
     };
     // Largest distance from quad f's samples to the surface.
     auto quad_distance = [&](int f) {
@@ -311,12 +311,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     for (int round = 0; round < options.fit_rounds; ++round) {
       std::vector<Triangle> quad_tris;
       std::vector<int> quad_of;
-      for (int f = 0; f < nf; ++f)
-        if (q.degree(f) == 4)
-          for (int t = 0; t < 2; ++t) {
-            quad_tris.push_back(quad_triangle(f, t));
-            quad_of.push_back(f);
-          }
+      for (int f = 0; f < nf; ++f)  // every face: samples under a polygon are not a quad's
+        for (int t = 0; t + 2 < q.degree(f); ++t) {
+          quad_tris.push_back(quad_triangle(f, t));
+          quad_of.push_back(f);
+        }
       if (quad_tris.empty()) return;
       TriangleTree quad_tree(quad_tris.begin(), quad_tris.end());
       quad_tree.accelerate_distance_queries();
@@ -354,7 +353,12 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         for (int f = 0; f < nf; ++f) largest = std::max(largest, quad_dist[f]);
         for (int s = 0; s < ns; ++s) largest = std::max(largest, sample_dist[s]);
         res.stats.fit_distance_before = largest / diag;
-        threshold = options.fit_fraction * largest;
+        // Relative to what the movable vertices can change (a boundary cut off, or a polygon's
+        // samples, may be farther).
+        double movable = 0;
+        for (int v = 0; v < nv; ++v)
+          if (!frozen[v]) movable = std::max(movable, local_distance(v));
+        threshold = options.fit_fraction * movable;
       }
       // Farthest first; among vertices sharing their worst point (the four of a quad), the
       // nearest to it first.

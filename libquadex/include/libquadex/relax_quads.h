@@ -44,11 +44,12 @@ struct RelaxOptions {
   // Shape fitting, last: the quads are moved closer to the surface where they are farthest from
   // it. A vertex (not fixed, not on a feature, only of quads) whose local distance (the largest
   // two-sided distance between its quads and the surface under them) exceeds fit_fraction of the
-  // largest over the mesh before fitting moves to the surface sample (a vertex of the surface or
-  // a point inside one of its triangles) under its quads, within half its mean quad edge length,
-  // that lowers its local distance most, if every quad around it keeps its quality or stays at
-  // least fit_min_quality; farthest vertices first, up to fit_rounds rounds. Vertices stay on the
-  // surface. It brings in tips and ridges that the quads cut off. fit_fraction 0 = off.
+  // largest local distance of the vertices that may move, before fitting, moves to the surface
+  // sample (a vertex of the surface or a point inside one of its triangles) under its quads,
+  // within half its mean quad edge length, that lowers its local distance most, if every quad
+  // around it keeps its quality or stays at least fit_min_quality; farthest vertices first, up to
+  // fit_rounds rounds. Vertices stay on the surface. It brings in tips and ridges that the quads
+  // cut off. fit_fraction 0 = off.
   double fit_fraction = 0.8;
   double fit_min_quality = 0.5;
   int fit_rounds = 3;
@@ -65,7 +66,7 @@ struct RelaxStats {
   int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
   int n_snapped = 0;     // vertices moved onto a feature they were near (see snap_reach)
   int n_fitted = 0;      // moves of the shape fitting (see fit_fraction)
-  // Largest two-sided distance between the quads and the surface samples (× bounding-box
+  // Largest two-sided distance between the faces and the surface samples (× bounding-box
   // diagonal) before and after the shape fitting, as it measures it (0 when it did not run).
   double fit_distance_before = 0, fit_distance_after = 0;
   double seconds = 0;
