@@ -261,7 +261,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   };
   // Shape fitting (see RelaxOptions::fit_fraction). The quads are measured as two triangles each,
   // (0,1,2) and (0,2,3), as core::to_trimesh and the metrics split them. Surface samples (the
-  // vertices and three interior points per triangle) are owned by their closest quad at the start
+  // vertices and three interior points per triangle) are owned by their closest face at the start
   // of a round; a vertex's local distance is the largest of its quads' distances to the surface
   // (barycentric grid samples) and of its owned samples' distances to its quads.
   auto fit_to_surface = [&](const std::vector<char>& frozen) {
@@ -306,6 +306,12 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
                                 CGAL::squared_distance(p, quad_triangle(f, 1))));
     };
     std::vector<double> quad_dist(nf, 0), sample_dist(ns, 0);
+    auto largest_distance = [&]() {
+      double d = 0;
+      for (int f = 0; f < nf; ++f) d = std::max(d, quad_dist[f]);
+      for (int s = 0; s < ns; ++s) d = std::max(d, sample_dist[s]);
+      return d;
+    };
     std::vector<int> owner(ns, -1);
     double threshold = 0;  // local distances above it are fitted
     for (int round = 0; round < options.fit_rounds; ++round) {
@@ -349,10 +355,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       };
       auto local_distance = [&](int v) { return local_distance_at(v).first; };
       if (round == 0) {
-        double largest = 0;
-        for (int f = 0; f < nf; ++f) largest = std::max(largest, quad_dist[f]);
-        for (int s = 0; s < ns; ++s) largest = std::max(largest, sample_dist[s]);
-        res.stats.fit_distance_before = largest / diag;
+        res.stats.fit_distance_before = largest_distance() / diag;
         // Relative to what the movable vertices can change (a boundary cut off, or a polygon's
         // samples, may be farther).
         double movable = 0;
@@ -379,6 +382,12 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         for (int f : vertex_quads[v]) mine.insert(mine.end(), owned[f].begin(), owned[f].end());
         std::vector<double> quality;
         for (int f : vertex_quads[v]) quality.push_back(quad_quality(f));
+        // Distance from sample s to v's quads.
+        auto star_distance = [&](int s) {
+          double ds = std::numeric_limits<double>::infinity();
+          for (int f : vertex_quads[v]) ds = std::min(ds, sample_distance(s, f));
+          return ds;
+        };
         // The local distance with v at its current position, or any value ≥ bound once it
         // reaches bound.
         auto evaluate = [&](double bound) {
@@ -388,9 +397,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
             if (d >= bound) return d;
           }
           for (int s : mine) {
-            double ds = std::numeric_limits<double>::infinity();
-            for (int f : vertex_quads[v]) ds = std::min(ds, sample_distance(s, f));
-            d = std::max(d, ds);
+            d = std::max(d, star_distance(s));
             if (d >= bound) return d;
           }
           return d;
@@ -425,27 +432,20 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         q.V.row(v) = samples[best_sample].transpose();
         ++moves;
         for (int f : vertex_quads[v]) quad_dist[f] = quad_distance(f);
-        for (int s : mine) {
-          double ds = std::numeric_limits<double>::infinity();
-          for (int f : vertex_quads[v]) ds = std::min(ds, sample_distance(s, f));
-          sample_dist[s] = ds;
-        }
+        for (int s : mine) sample_dist[s] = star_distance(s);
       }
       res.stats.n_fitted += moves;
-      double after = 0;
-      for (int f = 0; f < nf; ++f) after = std::max(after, quad_dist[f]);
-      for (int s = 0; s < ns; ++s) after = std::max(after, sample_dist[s]);
-      res.stats.fit_distance_after = after / diag;
+      res.stats.fit_distance_after = largest_distance() / diag;
       if (moves == 0) break;
     }
   };
   // Snapping, in vertex order; vertices of faces that are not quads stay (their shape is not
   // checked).
+  std::vector<char> touches_polygon(nv, 0);
+  for (int f = 0; f < nf; ++f)
+    if (q.degree(f) != 4)
+      for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
   if (feature_tree && options.snap_reach > 0) {
-    std::vector<char> touches_polygon(nv, 0);
-    for (int f = 0; f < nf; ++f)
-      if (q.degree(f) != 4)
-        for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
     for (int v = 0; v < nv; ++v) {
       if (fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v]) continue;
       if (snap_onto_feature(v)) {
@@ -477,10 +477,8 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   if (options.fit_fraction > 0 && options.fit_rounds > 0) {
     std::vector<char> fit_frozen(nv, 0);
-    for (int v = 0; v < nv; ++v) fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v];
-    for (int f = 0; f < nf; ++f)
-      if (q.degree(f) != 4)
-        for (int k = 0; k < q.degree(f); ++k) fit_frozen[q.vertex(f, k)] = 1;
+    for (int v = 0; v < nv; ++v)
+      fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v];
     fit_to_surface(fit_frozen);
   }
   res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
