@@ -57,6 +57,11 @@ constexpr double kFitReach = 0.5;
 constexpr size_t kFitFarthest = 16, kFitSpread = 48;
 // A fitting move is kept when it lowers the local distance by more than this (× diagonal).
 constexpr double kFitMinGain = 1e-9;
+// Sample jumps (see RelaxOptions::jump_reach): at most this many samples are tried per vertex,
+// evenly spread over those in reach by their distance.
+constexpr size_t kJumpCandidates = 96;
+// A jump does not land within this (× the mean quad edge) of another vertex of the vertex's quads.
+constexpr double kJumpApart = 0.05;
 
 }  // namespace
 
@@ -66,11 +71,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   RelaxResult res;
   res.quads = quads;
   if (!(options.min_scaled_jacobian <= 1) || options.max_rounds < 0 || options.rings < 0 ||
-      !(options.snap_reach >= 0) || !(options.snap_min_quality <= 1) ||
+      !(options.snap_reach >= 0) || !(options.snap_min_quality <= 1) || !(options.jump_reach >= 0) ||
       !(options.fit_fraction >= 0) || !(options.fit_min_quality <= 1) || options.fit_rounds < 0) {
     res.status = core::Status::invalid_input(
         "relax options: need min_scaled_jacobian ≤ 1, max_rounds ≥ 0, rings ≥ 0, snap_reach ≥ 0, "
-        "snap_min_quality ≤ 1, fit_fraction ≥ 0, fit_min_quality ≤ 1, fit_rounds ≥ 0");
+        "snap_min_quality ≤ 1, jump_reach ≥ 0, fit_fraction ≥ 0, fit_min_quality ≤ 1, fit_rounds ≥ 0");
     return res;
   }
   const int nv = quads.n_vertices(), nf = quads.n_faces();
@@ -137,6 +142,41 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
           on_feature[v] = 1;
     }
   }
+
+  // Surface samples, the positions the sample jumps and the shape fitting try: the surface's
+  // vertices and three interior points per (non-degenerate) triangle. by_x: their indices sorted
+  // by x, for range queries.
+  std::vector<Eigen::Vector3d> samples;
+  {
+    std::vector<char> used(surface.n_vertices(), 0);
+    for (int f = 0; f < surface.n_faces(); ++f)
+      for (int k = 0; k < 3; ++k) used[surface.F(f, k)] = 1;
+    for (int v = 0; v < surface.n_vertices(); ++v)
+      if (used[v]) samples.push_back(surface.V.row(v).transpose());
+    for (const Triangle& t : triangles)
+      for (int k = 0; k < 3; ++k) {
+        const Point p = CGAL::barycenter(t[k], 4.0, t[(k + 1) % 3], 1.0, t[(k + 2) % 3], 1.0);
+        samples.emplace_back(p.x(), p.y(), p.z());
+      }
+  }
+  const int ns = static_cast<int>(samples.size());
+  std::vector<int> by_x(static_cast<size_t>(ns));
+  for (int s = 0; s < ns; ++s) by_x[s] = s;
+  std::stable_sort(by_x.begin(), by_x.end(), [&](int a, int b) { return samples[a].x() < samples[b].x(); });
+  // Indices of the samples within r of p, nearest first (ties by index).
+  auto samples_near = [&](const Eigen::Vector3d& p, double r) {
+    auto lo = std::lower_bound(by_x.begin(), by_x.end(), p.x() - r,
+                               [&](int s, double x) { return samples[s].x() < x; });
+    std::vector<std::pair<double, int>> found;
+    for (auto it = lo; it != by_x.end() && samples[*it].x() <= p.x() + r; ++it) {
+      const double d = (samples[*it] - p).norm();
+      if (d <= r) found.emplace_back(d, *it);
+    }
+    std::sort(found.begin(), found.end());
+    std::vector<int> out;
+    for (const auto& [d, s] : found) out.push_back(s);
+    return out;
+  };
 
   core::PolyMesh& q = res.quads;
   // Quality of quad f: its worst corner scaled Jacobian (see RelaxOptions); a quad facing away
@@ -229,6 +269,73 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     }
     return total;
   };
+  // Sample jumps (see RelaxOptions::jump_reach) for the quads below `threshold`: each vertex of
+  // such a quad (not frozen) tries the surface samples near it, nearest first, and takes the
+  // first that lifts every quad around it to `threshold`, else the one that raises their worst
+  // quality most; no quad around it may fall below `threshold` (or its quality, if lower).
+  // Rounds until nothing moves. Returns the moves.
+  auto jump_rounds = [&](const std::vector<char>& frozen, double threshold) {
+    int total = 0;
+    if (!(options.jump_reach > 0)) return total;
+    for (int round = 0; round < options.max_rounds; ++round) {
+      std::vector<int> set;
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4 && quad_quality(f) < threshold)
+          for (int k = 0; k < 4; ++k) set.push_back(q.vertex(f, k));
+      std::sort(set.begin(), set.end());
+      set.erase(std::unique(set.begin(), set.end()), set.end());
+      int moves = 0;
+      for (int v : set) {
+        if (frozen[v]) continue;
+        const Eigen::Vector3d old = q.V.row(v).transpose();
+        double h = 0;
+        for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
+        h /= static_cast<double>(neighbours[v].size());
+        std::vector<int> candidates = samples_near(old, options.jump_reach * h);
+        if (candidates.size() > kJumpCandidates) {  // spread over the disk, nearest first
+          for (size_t i = 0; i < kJumpCandidates; ++i) candidates[i] = candidates[i * candidates.size() / kJumpCandidates];
+          candidates.resize(kJumpCandidates);
+        }
+        // Not onto another vertex of its quads (a quad with a zero edge reads as merely flat).
+        auto taken = [&](int s) {
+          for (int f : vertex_quads[v])
+            for (int k = 0; k < 4; ++k)
+              if (q.vertex(f, k) != v && (q.V.row(q.vertex(f, k)).transpose() - samples[s]).norm() <= kJumpApart * h)
+                return true;
+          return false;
+        };
+        std::vector<double> before;
+        for (int f : vertex_quads[v]) before.push_back(quad_quality(f));
+        double best = *std::min_element(before.begin(), before.end()) + kMinImprovement;
+        int best_sample = -1;
+        for (int s : candidates) {
+          if (taken(s)) continue;
+          q.V.row(v) = samples[s].transpose();
+          // The worst quad around v gets better, and no good quad becomes bad.
+          double w = std::numeric_limits<double>::infinity();
+          for (size_t i = 0; i < before.size() && w > best; ++i) {
+            const double quality = quad_quality(vertex_quads[v][i]);
+            w = quality < std::min(before[i], threshold) ? -std::numeric_limits<double>::infinity()
+                                                          : std::min(w, quality);
+          }
+          if (w > best) {
+            best = w;
+            best_sample = s;
+            if (w >= threshold) break;  // repaired: the nearest such sample
+          }
+        }
+        if (best_sample < 0) {
+          q.V.row(v) = old.transpose();
+        } else {
+          q.V.row(v) = samples[best_sample].transpose();
+          ++moves;
+        }
+      }
+      total += moves;
+      if (moves == 0) break;
+    }
+    return total;
+  };
   // Moves vertex v onto the closest point p of the features when p is within snap_reach of v's
   // mean quad edge, no quad edge around v passes by p already, and every quad around v keeps its
   // quality or stays at least snap_min_quality (see RelaxOptions::snap_reach); true if it moved.
@@ -266,20 +373,6 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // (barycentric grid samples) and of its owned samples' distances to its quads.
   auto fit_to_surface = [&](const std::vector<char>& frozen) {
     const double diag = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
-    std::vector<Eigen::Vector3d> samples;
-    {
-      std::vector<char> used(surface.n_vertices(), 0);
-      for (int f = 0; f < surface.n_faces(); ++f)
-        for (int k = 0; k < 3; ++k) used[surface.F(f, k)] = 1;
-      for (int v = 0; v < surface.n_vertices(); ++v)
-        if (used[v]) samples.push_back(surface.V.row(v).transpose());
-      for (const Triangle& t : triangles)
-        for (int k = 0; k < 3; ++k) {
-          const Point p = CGAL::barycenter(t[k], 4.0, t[(k + 1) % 3], 1.0, t[(k + 2) % 3], 1.0);
-          samples.emplace_back(p.x(), p.y(), p.z());
-        }
-    }
-    const int ns = static_cast<int>(samples.size());
     // Triangle t of face f's fan (0, t+1, t+2): for a quad (0,1,2) and (0,2,3).
     auto quad_triangle = [&](int f, int t) {
       auto pt = [&](int j) { return Point(q.V(q.vertex(f, j), 0), q.V(q.vertex(f, j), 1), q.V(q.vertex(f, j), 2)); };
@@ -456,7 +549,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   std::vector<char> frozen(nv);
   for (int v = 0; v < nv; ++v) frozen[v] = fixed[v] || on_feature[v];
+  // Jumps first: where they repair a quad, its neighbours need not slide (which, around a thin
+  // tip, pulls the quads off it); the steps then repair what the jumps could not.
+  res.stats.n_jumps = jump_rounds(frozen, options.min_scaled_jacobian);
   res.stats.n_moves = relax_rounds(frozen, options.min_scaled_jacobian);
+  res.stats.n_jumps += jump_rounds(frozen, options.min_scaled_jacobian);
   // Last resort for quads still flipped: their vertices on features and boundaries may leave
   // them (a flipped or flat quad is worse than a crease or boundary missed by a fraction of a
   // quad: e.g. a boundary corner placed where the boundary runs straight).
@@ -472,6 +569,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     for (int v = 0; v < nv; ++v)
       if (released[v]) frozen[v] = 0;
     res.stats.n_moves += relax_rounds(frozen, kFlipped);
+    res.stats.n_jumps += jump_rounds(frozen, kFlipped);
     for (int v = 0; v < nv; ++v)
       if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
   }

@@ -49,7 +49,7 @@ TEST(RelaxQuads, RepairsAReflexCornerOnThePlane) {
   EXPECT_GE(r.stats.n_flipped_before, 1);
   EXPECT_EQ(r.stats.n_flipped_after, 0);
   EXPECT_EQ(r.stats.n_bad_after, 0);
-  EXPECT_GT(r.stats.n_moves, 0);
+  EXPECT_GT(r.stats.n_moves + r.stats.n_jumps, 0);
   for (int w = 0; w < q.n_vertices(); ++w) {
     EXPECT_NEAR(r.quads.V(w, 2), 0.0, 1e-12) << "vertex " << w << " left the surface";
     const int i = w % (n + 1), j = w / (n + 1);
@@ -58,6 +58,36 @@ TEST(RelaxQuads, RepairsAReflexCornerOnThePlane) {
     }
   }
   EXPECT_EQ(r.quads.face_vertex, q.face_vertex);
+}
+
+TEST(RelaxQuads, JumpsToASurfaceSampleThatRepairs) {
+  // The reflex corner of RepairsAReflexCornerOnThePlane: the pushed vertex jumps (in one move)
+  // to one of the surface samples within its mean quad edge (about 1.9) of it: the square's
+  // triangles (0,0)-(4,0)-(4,4) and (0,0)-(4,4)-(0,4) have interior samples at 4:1:1 weights.
+  // Without jumps (jump_reach 0) the smoothing steps repair it instead.
+  const int n = 4;
+  core::PolyMesh q = grid(n);
+  const int v = 1 * (n + 1) + 1;
+  q.V.row(v) << 2.3, 2.2, 0;
+  const RelaxResult jumped = relax_bad_quads(q, square(n));
+  ASSERT_TRUE(jumped.status.is_ok()) << jumped.status.to_string();
+  EXPECT_GE(jumped.stats.n_jumps, 1);
+  EXPECT_EQ(jumped.stats.n_flipped_after, 0);
+  EXPECT_EQ(jumped.stats.n_bad_after, 0);
+  const double third = 4.0 / 6.0;
+  const Eigen::Vector3d samples[] = {{2 * third, third, 0}, {5 * third, third, 0}, {5 * third, 4 * third, 0},
+                                     {third, 2 * third, 0}, {4 * third, 5 * third, 0}, {third, 5 * third, 0}};
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector3d& s : samples) nearest = std::min(nearest, (jumped.quads.V.row(v).transpose() - s).norm());
+  EXPECT_LT(nearest, 1e-12) << "the vertex is not at a surface sample: " << jumped.quads.V.row(v);
+
+  RelaxOptions no_jumps;
+  no_jumps.jump_reach = 0;
+  const RelaxResult slid = relax_bad_quads(q, square(n), no_jumps);
+  ASSERT_TRUE(slid.status.is_ok());
+  EXPECT_EQ(slid.stats.n_jumps, 0);
+  EXPECT_GT(slid.stats.n_moves, 0);
+  EXPECT_EQ(slid.stats.n_flipped_after, 0);
 }
 
 TEST(RelaxQuads, LeavesAGoodGridUnchanged) {
@@ -282,6 +312,9 @@ TEST(RelaxQuads, RejectsBadInput) {
   EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad_snap).status.code(), core::StatusCode::kInvalidInput);
   bad_snap.snap_reach = -1;
   EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad_snap).status.code(), core::StatusCode::kInvalidInput);
+  RelaxOptions bad_jump;
+  bad_jump.jump_reach = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(relax_bad_quads(grid(2), square(2), bad_jump).status.code(), core::StatusCode::kInvalidInput);
 }
 
 }  // namespace

@@ -253,6 +253,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"flipped_before", relax_stats.n_flipped_before},
                        {"flipped_after", relax_stats.n_flipped_after},
                        {"moves", relax_stats.n_moves},
+                       {"jumps", relax_stats.n_jumps},
                        {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
                        {"snapped", relax_stats.n_snapped},
                        {"fitted", relax_stats.n_fitted},

@@ -41,6 +41,15 @@ struct RelaxOptions {
   // the curve: a flipped or flat quad is worse than a crease or boundary missed by a fraction of
   // a quad), as a last resort.
   bool release_features_for_flips = true;
+  // Sample jumps, before the steps above (and again after them, and after the last resort for
+  // the quads still flipped): a vertex of a quad below min_scaled_jacobian moves to a surface
+  // sample (a vertex of the surface or a point inside one of its triangles) within jump_reach of
+  // its mean quad edge length: the nearest that lifts every quad around it to the threshold,
+  // else the one that raises their worst quality most, never making a good quad bad. The steps
+  // slide a vertex by a fraction of its edges and move its neighbours too, which cannot untwist
+  // a quad folded around a knife edge thinner than a quad (a screwdriver's blade) and pulls the
+  // quads off a thin tip. 0 = off.
+  double jump_reach = 1.0;
   // Shape fitting, last: the quads are moved closer to the surface where they are farthest from
   // it. A vertex (not fixed, not on a feature, only of quads) whose local distance (the largest
   // two-sided distance between its quads and the surface under them) exceeds fit_fraction of the
@@ -63,6 +72,7 @@ struct RelaxStats {
   // flips); the repair treats such a quad's cosine to that normal as its quality.
   int n_flipped_before = 0, n_flipped_after = 0;
   int n_moves = 0;       // accepted vertex moves
+  int n_jumps = 0;       // sample jumps (see jump_reach)
   int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
   int n_snapped = 0;     // vertices moved onto a feature they were near (see snap_reach)
   int n_fitted = 0;      // moves of the shape fitting (see fit_fraction)
