@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 #include <numeric>
 #include <stdexcept>
@@ -284,9 +285,22 @@ std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, con
     if (2 * n_kept[g] >= n_all[g]) keep[e] = 1;
   }
   group_sizes(keep, &n_kept);
+  // Median dihedral angle of each small group.
+  std::map<int, std::vector<double>> small_groups;
+  for (const int e : sharp) {
+    const int g = find(topo.edge_vertex(e, 0));
+    if (keep[e] && n_kept[g] < options.min_group_edges) small_groups[g].push_back(dihedral[e]);
+  }
+  std::vector<char> sharp_group(nv, 0);
+  for (auto& [g, angles] : small_groups) {
+    std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
+    sharp_group[g] = angles[angles.size() / 2] >= options.keep_small_group_deg;
+  }
   std::vector<int> creases;
-  for (const int e : sharp)
-    if (keep[e] && n_kept[find(topo.edge_vertex(e, 0))] >= options.min_group_edges) creases.push_back(e);
+  for (const int e : sharp) {
+    const int g = find(topo.edge_vertex(e, 0));
+    if (keep[e] && (n_kept[g] >= options.min_group_edges || sharp_group[g])) creases.push_back(e);
+  }
   return creases;
 }
 

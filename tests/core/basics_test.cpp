@@ -19,6 +19,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -227,6 +228,43 @@ TEST(TopologyTest, CreaseFilterLeavesOutTheSharpEdgesOfAnOrganicMesh) {
   CreaseOptions strict;
   strict.max_side_angle_deg = 1;
   EXPECT_TRUE(crease_edges(spot, topo, strict).empty()) << "no sharp edge of spot has flat sides";
+}
+
+// Two flat strips of n squares along x meeting at the edge y = z = 0: the top (y from 0 to 1,
+// z = 0) and one opening by `opening` degrees below it (a blade's edge for a small opening).
+TriMesh folded_strips(int n, double opening) {
+  const double a = opening * std::numbers::pi / 180;
+  TriMesh m;
+  m.V.resize(3 * (n + 1), 3);
+  for (int i = 0; i <= n; ++i) {
+    m.V.row(i) << i, 0, 0;                                        // edge
+    m.V.row(n + 1 + i) << i, 1, 0;                                // top
+    m.V.row(2 * (n + 1) + i) << i, std::cos(a), -std::sin(a);     // underside
+  }
+  m.F.resize(4 * n, 3);
+  for (int i = 0; i < n; ++i) {
+    const int e = i, t = n + 1 + i, u = 2 * (n + 1) + i;
+    m.F.row(4 * i) << e, e + 1, t + 1;
+    m.F.row(4 * i + 1) << e, t + 1, t;
+    m.F.row(4 * i + 2) << e + 1, e, u;
+    m.F.row(4 * i + 3) << e + 1, u, u + 1;
+  }
+  return m;
+}
+
+TEST(TopologyTest, AShortKnifeEdgeIsACreaseAShortFoldIsNot) {
+  // Three sharp edges with flat sides: too few for a group, unless they are a knife edge.
+  const TriMesh knife = folded_strips(3, 10);  // dihedral angle 170°
+  const EdgeTopology knife_topo = build_edge_topology(knife);
+  ASSERT_EQ(sharp_edges(knife, knife_topo, 40).size(), 3u);
+  EXPECT_EQ(crease_edges(knife, knife_topo, CreaseOptions{}).size(), 3u);
+  CreaseOptions no_exception;
+  no_exception.keep_small_group_deg = 180;
+  EXPECT_TRUE(crease_edges(knife, knife_topo, no_exception).empty());
+  const TriMesh fold = folded_strips(3, 110);  // dihedral angle 70°
+  const EdgeTopology fold_topo = build_edge_topology(fold);
+  ASSERT_EQ(sharp_edges(fold, fold_topo, 40).size(), 3u);
+  EXPECT_TRUE(crease_edges(fold, fold_topo, CreaseOptions{}).empty());
 }
 
 TEST(PredicatesTest, Orient2dSignsAndExactness) {

@@ -94,7 +94,8 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
                  "Keep only sharp edges that are creases between two smooth sides: a chain of sharp "
                  "edges is dropped when the median, over its edges, of the largest dihedral angle of "
                  "the other edges of their faces is at least this (degrees), and so are groups of "
-                 "fewer than 6 sharp edges; this leaves out the sharp edges of scans and sculpts "
+                 "fewer than 6 sharp edges unless their median dihedral angle is at least 120 degrees "
+                 "(a short knife edge, such as a blade's tip, stays); this leaves out the sharp edges of scans and sculpts "
                  "(coarsely tessellated tips, folds and crevices); 0 = every sharp edge")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));

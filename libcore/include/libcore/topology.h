@@ -65,6 +65,9 @@ struct CreaseOptions {
   // Connected groups of kept sharp edges with fewer edges than this are dropped (isolated
   // fragments); applies only when max_side_angle_deg > 0.
   int min_group_edges = 6;
+  // ... unless the median dihedral angle of the group's edges is at least this (degrees): a short
+  // knife edge (a blade's tip) is a crease however few edges it has.
+  double keep_small_group_deg = 120;
 };
 
 // Sharp edges (as sharp_edges) that pass the crease filter of `options`, in increasing order.
