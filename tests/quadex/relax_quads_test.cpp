@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
 namespace quadify::quadex {
 namespace {
@@ -41,53 +42,42 @@ TEST(RelaxQuads, RepairsAReflexCornerOnThePlane) {
   const int n = 4;
   core::PolyMesh q = grid(n);
   // Interior vertex (1, 1) pushed past its diagonal neighbour's corner: the quad (1,1)-(2,2)
-  // gets a reflex corner.
+  // gets a reflex corner. By default it jumps (in one move) to one of the surface samples within
+  // its mean quad edge (about 1.9) of it: the square's triangles (0,0)-(4,0)-(4,4) and
+  // (0,0)-(4,4)-(0,4) have interior samples at 4:1:1 weights. Without jumps (jump_reach 0) the
+  // smoothing steps repair it.
   const int v = 1 * (n + 1) + 1;
   q.V.row(v) << 2.3, 2.2, 0;
-  const RelaxResult r = relax_bad_quads(q, square(n));
-  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
-  EXPECT_GE(r.stats.n_flipped_before, 1);
-  EXPECT_EQ(r.stats.n_flipped_after, 0);
-  EXPECT_EQ(r.stats.n_bad_after, 0);
-  EXPECT_GT(r.stats.n_moves + r.stats.n_jumps, 0);
-  for (int w = 0; w < q.n_vertices(); ++w) {
-    EXPECT_NEAR(r.quads.V(w, 2), 0.0, 1e-12) << "vertex " << w << " left the surface";
-    const int i = w % (n + 1), j = w / (n + 1);
-    if (i == 0 || j == 0 || i == n || j == n) {
-      EXPECT_EQ(r.quads.V.row(w), q.V.row(w)) << "boundary vertex " << w << " moved";
-    }
-  }
-  EXPECT_EQ(r.quads.face_vertex, q.face_vertex);
-}
-
-TEST(RelaxQuads, JumpsToASurfaceSampleThatRepairs) {
-  // The reflex corner of RepairsAReflexCornerOnThePlane: the pushed vertex jumps (in one move)
-  // to one of the surface samples within its mean quad edge (about 1.9) of it: the square's
-  // triangles (0,0)-(4,0)-(4,4) and (0,0)-(4,4)-(0,4) have interior samples at 4:1:1 weights.
-  // Without jumps (jump_reach 0) the smoothing steps repair it instead.
-  const int n = 4;
-  core::PolyMesh q = grid(n);
-  const int v = 1 * (n + 1) + 1;
-  q.V.row(v) << 2.3, 2.2, 0;
-  const RelaxResult jumped = relax_bad_quads(q, square(n));
-  ASSERT_TRUE(jumped.status.is_ok()) << jumped.status.to_string();
-  EXPECT_GE(jumped.stats.n_jumps, 1);
-  EXPECT_EQ(jumped.stats.n_flipped_after, 0);
-  EXPECT_EQ(jumped.stats.n_bad_after, 0);
   const double third = 4.0 / 6.0;
   const Eigen::Vector3d samples[] = {{2 * third, third, 0}, {5 * third, third, 0}, {5 * third, 4 * third, 0},
                                      {third, 2 * third, 0}, {4 * third, 5 * third, 0}, {third, 5 * third, 0}};
-  double nearest = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector3d& s : samples) nearest = std::min(nearest, (jumped.quads.V.row(v).transpose() - s).norm());
-  EXPECT_LT(nearest, 1e-12) << "the vertex is not at a surface sample: " << jumped.quads.V.row(v);
-
-  RelaxOptions no_jumps;
-  no_jumps.jump_reach = 0;
-  const RelaxResult slid = relax_bad_quads(q, square(n), no_jumps);
-  ASSERT_TRUE(slid.status.is_ok());
-  EXPECT_EQ(slid.stats.n_jumps, 0);
-  EXPECT_GT(slid.stats.n_moves, 0);
-  EXPECT_EQ(slid.stats.n_flipped_after, 0);
+  for (const double reach : {RelaxOptions{}.jump_reach, 0.0}) {
+    SCOPED_TRACE("jump_reach " + std::to_string(reach));
+    RelaxOptions options;
+    options.jump_reach = reach;
+    const RelaxResult r = relax_bad_quads(q, square(n), options);
+    ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+    EXPECT_GE(r.stats.n_flipped_before, 1);
+    EXPECT_EQ(r.stats.n_flipped_after, 0);
+    EXPECT_EQ(r.stats.n_bad_after, 0);
+    for (int w = 0; w < q.n_vertices(); ++w) {
+      EXPECT_NEAR(r.quads.V(w, 2), 0.0, 1e-12) << "vertex " << w << " left the surface";
+      const int i = w % (n + 1), j = w / (n + 1);
+      if (i == 0 || j == 0 || i == n || j == n) {
+        EXPECT_EQ(r.quads.V.row(w), q.V.row(w)) << "boundary vertex " << w << " moved";
+      }
+    }
+    EXPECT_EQ(r.quads.face_vertex, q.face_vertex);
+    if (reach > 0) {
+      EXPECT_GE(r.stats.n_jumps, 1);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector3d& s : samples) nearest = std::min(nearest, (r.quads.V.row(v).transpose() - s).norm());
+      EXPECT_LT(nearest, 1e-12) << "the vertex is not at a surface sample: " << r.quads.V.row(v);
+    } else {
+      EXPECT_EQ(r.stats.n_jumps, 0);
+      EXPECT_GT(r.stats.n_moves, 0);
+    }
+  }
 }
 
 TEST(RelaxQuads, LeavesAGoodGridUnchanged) {
