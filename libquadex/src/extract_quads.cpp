@@ -695,6 +695,7 @@ class Extractor {
         const auto& F = map_.mesh.F;
         extra_pos_.push_back((1 - t) * map_.mesh.V.row(F(f, exit_halfedge % 3)).transpose() +
                              t * map_.mesh.V.row(F(f, (exit_halfedge % 3 + 1) % 3)).transpose());
+        extra_face_.push_back(f);
         dangling.push_back({s, exit_halfedge, ev.vertex, acc});
         ++res_.stats.n_boundary_crossings;
         continue;
@@ -864,8 +865,11 @@ class Extractor {
     quads = core::PolyMesh{};
     const auto& V = map_.mesh.V;
     quads.V.resize(n_out_vertices_, 3);
+    res_.vertex_face.assign(n_out_vertices_, -1);
+    for (size_t i = 0; i < extra_face_.size(); ++i) res_.vertex_face[grid_.size() + i] = extra_face_[i];
     for (size_t i = 0; i < grid_.size(); ++i) {
       const GridPoint& g = grid_[i];
+      res_.vertex_face[i] = g.face;
       if (g.where == Where::kVertex) {
         quads.V.row(i) = V.row(g.elem);
         ++res_.stats.n_grid_points_on_vertices;
@@ -969,6 +973,7 @@ class Extractor {
   int n_out_vertices_ = 0;             // grid points, then boundary crossings
   std::vector<Eigen::Vector2d> extra_uv_;  // per boundary crossing: UV in its edge's face chart
   std::vector<Eigen::Vector3d> extra_pos_;
+  std::vector<int> extra_face_;  // the face of each boundary crossing
   std::unordered_map<int, std::vector<BoundaryEvent>> boundary_events_;  // boundary half-edge →
   std::unordered_map<int, std::pair<int, int>> event_position_;  // vertex → (half-edge, index)
   std::unordered_map<int, int> reverse_of_vertex_;  // crossing vertex → half-edge leaving inwards

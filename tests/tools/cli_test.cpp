@@ -318,7 +318,9 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
 
 // A component smaller than a quad (a 2 cm flake beside a torus remeshed at 400 quads) gets no
 // quad; the remesher says so on stderr and in the report instead of dropping it silently.
-TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
+// The torus and a flat flake far from it, 0.02 wide, with n×n vertices: far smaller than a quad
+// at 400 quads, so the flake gets no grid point.
+fs::path torus_and_flake(const fs::path& dir, int n) {
   std::ostringstream obj;
   obj << slurp(data_path("torus.obj"));
   int nv = 0;
@@ -328,15 +330,43 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
       if (line.rfind("v ", 0) == 0) ++nv;
   }
   obj << "\n";
-  for (int j = 0; j < 3; ++j)
-    for (int i = 0; i < 3; ++i) obj << "v " << 10 + 0.01 * i << " " << 0.01 * j << " 0\n";
-  for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) {
-      const int a = nv + 1 + 3 * j + i, b = a + 1, c = a + 3, d = c + 1;
+  const double step = 0.02 / (n - 1);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) obj << "v " << 10 + step * i << " " << step * j << " 0\n";
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = nv + 1 + n * j + i, b = a + 1, c = a + n, d = c + 1;
       obj << "f " << a << " " << b << " " << d << "\nf " << a << " " << d << " " << c << "\n";
     }
-  const fs::path in = dir_ / "torus_flake.obj";
+  const fs::path in = dir / ("torus_flake" + std::to_string(n) + ".obj");
   write_text(in, obj.str());
+  return in;
+}
+
+// A flake of 8 triangles is split into 24 quads of its own (three per triangle): the output
+// keeps both components and stays pure quad.
+TEST_F(CliTest, RemeshSplitsAComponentTooSmallForTheGrid) {
+  const fs::path in = torus_and_flake(dir_, 3);
+  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
+  args.append("'").append(in.string()).append("' -o '").append((dir_ / "o.obj").string());
+  args.append("' --target-faces 400 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 component(s) too small for the quad grid"), std::string::npos) << r.err;
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["mesh"]["components"], 2);
+  EXPECT_EQ(report["quads"]["components"], 2);
+  EXPECT_EQ(report["quads"]["components_lost"], 0);
+  EXPECT_EQ(report["quads"]["non_quads"], 0);
+  EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+  EXPECT_EQ(report["small_components"]["replaced"], 1);
+  EXPECT_EQ(report["small_components"]["quads_added"], 24);
+}
+
+// A flake of 162 triangles is more than the split takes (64): it gets no quads, and the
+// remesher says so.
+TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
+  const fs::path in = torus_and_flake(dir_, 10);
   std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
   args.append("'").append(in.string()).append("' -o '").append((dir_ / "o.obj").string());
   args.append("' --target-faces 400 --json '").append((dir_ / "r.json").string()).append("'");
@@ -347,6 +377,7 @@ TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
   EXPECT_EQ(report["mesh"]["components"], 2);
   EXPECT_EQ(report["quads"]["components"], 1);
   EXPECT_EQ(report["quads"]["components_lost"], 1);
+  EXPECT_EQ(report["small_components"]["replaced"], 0);
 }
 
 // At 12 quads the torus's tube is about one quad around: the first grid has a loop of a single

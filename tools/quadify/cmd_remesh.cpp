@@ -9,6 +9,7 @@
 #include <libquadex/extract_quads.h>
 #include <libquadex/quad_metrics.h>
 #include <libquadex/relax_quads.h>
+#include <libquadex/small_components.h>
 #include <libquantize/quantize.h>
 
 #include <algorithm>
@@ -186,6 +187,19 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     integer_map = std::move(finer);
     extracted = std::move(finer_quads);
   }
+  // Components too small for the grid (degenerate or non-quad faces): their triangles split.
+  quadex::SmallComponentResult small = quadex::split_small_components(integer_map.uv, extracted.quads, extracted.vertex_face);
+  if (!small.status.is_ok())
+    throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
+  if (small.stats.n_replaced > 0) {
+    extracted.quads = std::move(small.quads);
+    if (!common.quiet)
+      std::fprintf(stderr,
+                   "quadify: %s: %d component(s) too small for the quad grid (%d faces that were not "
+                   "all quads) became %d quads, three per input triangle\n",
+                   args.input.c_str(), small.stats.n_replaced, small.stats.n_faces_removed,
+                   small.stats.n_quads_added);
+  }
   quadex::RelaxStats relax_stats;
   if (args.relax) {
     progress.begin("relax");
@@ -247,6 +261,9 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   const quadex::ExtractStats& es = extracted.stats;
   report["extract"] = {{"vertices", es.n_vertices}, {"faces", es.n_faces}, {"non_quads", es.n_non_quads},
                        {"boundary_crossings", es.n_boundary_crossings}, {"seconds", es.seconds}};
+  report["small_components"] = {{"replaced", small.stats.n_replaced},
+                                 {"faces_removed", small.stats.n_faces_removed},
+                                 {"quads_added", small.stats.n_quads_added}};
   if (args.relax)
     report["relax"] = {{"bad_before", relax_stats.n_bad_before},
                        {"bad_after", relax_stats.n_bad_after},

@@ -6,6 +6,8 @@
 #include <libcore/mesh.h>
 #include <libcore/status.h>
 
+#include <vector>
+
 namespace quadify::quadex {
 
 struct ExtractOptions {
@@ -55,6 +57,7 @@ struct ExtractStats {
 struct ExtractResult {
   core::Status status;
   core::PolyMesh quads;  // CCW faces; uv/face_uv hold per-corner integer UVs when requested
+  std::vector<int> vertex_face;  // per quad vertex: the input face it was placed in
   ExtractStats stats;
 };
 
