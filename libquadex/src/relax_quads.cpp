@@ -201,6 +201,12 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   const double kFlipped = std::numeric_limits<double>::min();
   res.stats.n_bad_before = count_bad(options.min_scaled_jacobian);
   res.stats.n_flipped_before = count_bad(kFlipped);
+  // Mean length of the quad edges at vertex v (its current position).
+  auto mean_edge = [&](int v) {
+    double h = 0;
+    for (int w : neighbours[v]) h += (q.V.row(w) - q.V.row(v)).norm();
+    return h / static_cast<double>(neighbours[v].size());
+  };
   auto local_worst = [&](int v) {
     double w = std::numeric_limits<double>::infinity();
     for (int f : vertex_quads[v]) w = std::min(w, quad_quality(f));
@@ -288,9 +294,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       for (int v : set) {
         if (frozen[v]) continue;
         const Eigen::Vector3d old = q.V.row(v).transpose();
-        double h = 0;
-        for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
-        h /= static_cast<double>(neighbours[v].size());
+        const double h = mean_edge(v);
         std::vector<int> candidates = samples_near(old, options.jump_reach * h);
         if (candidates.size() > kJumpCandidates) {  // spread over the disk, nearest first
           for (size_t i = 0; i < kJumpCandidates; ++i) candidates[i] = candidates[i * candidates.size() / kJumpCandidates];
@@ -341,9 +345,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // quality or stays at least snap_min_quality (see RelaxOptions::snap_reach); true if it moved.
   auto snap_onto_feature = [&](int v) {
     const Eigen::Vector3d old = q.V.row(v).transpose();
-    double h = 0;
-    for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
-    h /= static_cast<double>(neighbours[v].size());
+    const double h = mean_edge(v);
     const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
     const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
     if (!((p - old).norm() <= options.snap_reach * h)) return false;
@@ -468,9 +470,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       int moves = 0;
       for (const auto& [neg_d, gap, v] : todo) {
         const Eigen::Vector3d old = q.V.row(v).transpose();
-        double h = 0;
-        for (int w : neighbours[v]) h += (q.V.row(w).transpose() - old).norm();
-        h /= static_cast<double>(neighbours[v].size());
+        const double h = mean_edge(v);
         std::vector<int> mine;
         for (int f : vertex_quads[v]) mine.insert(mine.end(), owned[f].begin(), owned[f].end());
         std::vector<double> quality;

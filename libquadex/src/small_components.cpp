@@ -63,7 +63,6 @@ SmallComponentResult split_small_components(const core::UVMesh& map, const core:
   }
   res.quads = core::PolyMesh{};
   core::PolyMesh& out = res.quads;
-  out.lines = quads.lines;
   const bool uv = quads.has_uv();
   std::vector<Eigen::Vector3d> positions;
   std::vector<Eigen::Vector2d> uvs;
@@ -137,7 +136,6 @@ SmallComponentResult split_small_components(const core::UVMesh& map, const core:
   }
   for (const auto& [vs, ts] : faces) out.add_face(vs, ts);
   // Lines refer to vertex ids: keep those whose ends survive.
-  out.lines.clear();
   for (const auto& [a, b] : quads.lines)
     if (a >= 0 && b >= 0 && a < quads.n_vertices() && b < quads.n_vertices() && new_id[a] >= 0 && new_id[b] >= 0)
       out.lines.push_back({new_id[a], new_id[b]});

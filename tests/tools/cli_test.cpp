@@ -316,11 +316,9 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["relax"]["snapped"], 0);
 }
 
-// A component smaller than a quad (a 2 cm flake beside a torus remeshed at 400 quads) gets no
-// quad; the remesher says so on stderr and in the report instead of dropping it silently.
 // The torus and a flat flake far from it, 0.02 wide, with n×n vertices: far smaller than a quad
 // at 400 quads, so the flake gets no grid point.
-fs::path torus_and_flake(const fs::path& dir, int n) {
+fs::path write_torus_and_flake(const fs::path& dir, int n) {
   std::ostringstream obj;
   obj << slurp(data_path("torus.obj"));
   int nv = 0;
@@ -343,14 +341,19 @@ fs::path torus_and_flake(const fs::path& dir, int n) {
   return in;
 }
 
+// quadify on write_torus_and_flake(n) at 400 quads, the report in dir/r.json.
+CliRun remesh_torus_and_flake(const fs::path& dir, int n) {
+  const fs::path in = write_torus_and_flake(dir, n);
+  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
+  args.append("'").append(in.string()).append("' -o '").append((dir / "o.obj").string());
+  args.append("' --target-faces 400 --json '").append((dir / "r.json").string()).append("'");
+  return quadify(args, dir);
+}
+
 // A flake of 8 triangles is split into 24 quads of its own (three per triangle): the output
 // keeps both components and stays pure quad.
 TEST_F(CliTest, RemeshSplitsAComponentTooSmallForTheGrid) {
-  const fs::path in = torus_and_flake(dir_, 3);
-  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
-  args.append("'").append(in.string()).append("' -o '").append((dir_ / "o.obj").string());
-  args.append("' --target-faces 400 --json '").append((dir_ / "r.json").string()).append("'");
-  const CliRun r = quadify(args, dir_);
+  const CliRun r = remesh_torus_and_flake(dir_, 3);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("1 component(s) too small for the quad grid"), std::string::npos) << r.err;
   const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
@@ -366,11 +369,7 @@ TEST_F(CliTest, RemeshSplitsAComponentTooSmallForTheGrid) {
 // A flake of 162 triangles is more than the split takes (64): it gets no quads, and the
 // remesher says so.
 TEST_F(CliTest, RemeshWarnsAboutComponentsThatGetNoQuads) {
-  const fs::path in = torus_and_flake(dir_, 10);
-  std::string args;  // appended piecewise (GCC 12's false -Wrestrict on "'" + string)
-  args.append("'").append(in.string()).append("' -o '").append((dir_ / "o.obj").string());
-  args.append("' --target-faces 400 --json '").append((dir_ / "r.json").string()).append("'");
-  const CliRun r = quadify(args, dir_);
+  const CliRun r = remesh_torus_and_flake(dir_, 10);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("1 of 2 components got no quads"), std::string::npos) << r.err;
   const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
