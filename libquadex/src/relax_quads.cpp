@@ -62,6 +62,10 @@ constexpr double kFitMinGain = 1e-9;
 constexpr size_t kJumpCandidates = 96;
 // A jump does not land within this (× the mean quad edge) of another vertex of the vertex's quads.
 constexpr double kJumpApart = 0.05;
+// Diagonal choice (see RelaxOptions::choose_diagonals): samples per triangle side of each split,
+// and the relative gain in distance a quad's other split must bring for its vertex order to turn.
+constexpr int kDiagonalSamples = 6;
+constexpr double kDiagonalGain = 0.01;
 
 }  // namespace
 
@@ -373,27 +377,66 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // vertices and three interior points per triangle) are owned by their closest face at the start
   // of a round; a vertex's local distance is the largest of its quads' distances to the surface
   // (barycentric grid samples) and of its owned samples' distances to its quads.
+  // Triangle t of face f's fan from corner `first` (first, first+t+1, first+t+2): for a quad split
+  // as the metrics and writers split it (first 0), (0,1,2) and (0,2,3).
+  auto quad_triangle = [&](int f, int t, int first = 0) {
+    const int d = q.degree(f);
+    auto pt = [&](int j) {
+      const int v = q.vertex(f, (first + j) % d);
+      return Point(q.V(v, 0), q.V(v, 1), q.V(v, 2));
+    };
+    return Triangle(pt(0), pt(t + 1), pt(t + 2));
+  };
+  // Largest distance from quad f's samples (a barycentric grid of n per side on each triangle of
+  // the split from corner `first`) to the surface.
+  auto quad_distance = [&](int f, int n = kFitQuadSamples, int first = 0) {
+    double worst = 0;
+    for (int t = 0; t < 2; ++t) {
+      const Triangle tri = quad_triangle(f, t, first);
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; i + j <= n; ++j) {
+          const double a = static_cast<double>(i) / n, b = static_cast<double>(j) / n;
+          const Point p = CGAL::barycenter(tri[0], 1 - a - b, tri[1], a, tri[2], b);
+          worst = std::max(worst, tree.squared_distance(p));
+        }
+    }
+    return std::sqrt(worst);
+  };
+  // Diagonal choice (see RelaxOptions::choose_diagonals): a quad whose split along its other
+  // diagonal (1,2,3), (1,3,0) lies closer to the surface, by more than kDiagonalGain, and whose
+  // two triangles of that split face the same way (the other split of a non-convex quad
+  // overlaps itself), starts at its next corner; only the quads with a vertex in `moved`, when
+  // given. Returns the quads turned.
+  auto choose_diagonals = [&](const std::vector<char>* moved) {
+    std::vector<char> turn(nf, 0);
+    parallel_for_each_index(static_cast<size_t>(nf), [&](size_t fi) {
+      const int f = static_cast<int>(fi);
+      if (q.degree(f) != 4) return;
+      if (moved && !(*moved)[q.vertex(f, 0)] && !(*moved)[q.vertex(f, 1)] && !(*moved)[q.vertex(f, 2)] &&
+          !(*moved)[q.vertex(f, 3)])
+        return;
+      const Triangle a = quad_triangle(f, 0, 1), b = quad_triangle(f, 1, 1);
+      if (CGAL::scalar_product(a.supporting_plane().orthogonal_vector(),
+                               b.supporting_plane().orthogonal_vector()) <= 0)
+        return;
+      if (quad_distance(f, kDiagonalSamples, 1) < (1 - kDiagonalGain) * quad_distance(f, kDiagonalSamples, 0))
+        turn[fi] = 1;
+    });
+    int n = 0;
+    for (int f = 0; f < nf; ++f)
+      if (turn[f]) {
+        const auto begin = q.face_vertex.begin() + q.face_offset[f];
+        std::rotate(begin, begin + 1, begin + 4);
+        if (q.has_uv()) {
+          const auto uv_begin = q.face_uv.begin() + q.face_offset[f];
+          std::rotate(uv_begin, uv_begin + 1, uv_begin + 4);
+        }
+        ++n;
+      }
+    return n;
+  };
   auto fit_to_surface = [&](const std::vector<char>& frozen) {
     const double diag = (surface.V.colwise().maxCoeff() - surface.V.colwise().minCoeff()).norm();
-    // Triangle t of face f's fan (0, t+1, t+2): for a quad (0,1,2) and (0,2,3).
-    auto quad_triangle = [&](int f, int t) {
-      auto pt = [&](int j) { return Point(q.V(q.vertex(f, j), 0), q.V(q.vertex(f, j), 1), q.V(q.vertex(f, j), 2)); };
-      return Triangle(pt(0), pt(t + 1), pt(t + 2));
-    };
-    // Largest distance from quad f's samples to the surface.
-    auto quad_distance = [&](int f) {
-      double worst = 0;
-      for (int t = 0; t < 2; ++t) {
-        const Triangle tri = quad_triangle(f, t);
-        for (int i = 0; i <= kFitQuadSamples; ++i)
-          for (int j = 0; i + j <= kFitQuadSamples; ++j) {
-            const double a = static_cast<double>(i) / kFitQuadSamples, b = static_cast<double>(j) / kFitQuadSamples;
-            const Point p = CGAL::barycenter(tri[0], 1 - a - b, tri[1], a, tri[2], b);
-            worst = std::max(worst, tree.squared_distance(p));
-          }
-      }
-      return std::sqrt(worst);
-    };
     // Distance from a sample to quad f.
     auto sample_distance = [&](int s, int f) {
       const Point p(samples[s].x(), samples[s].y(), samples[s].z());
@@ -573,11 +616,17 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     for (int v = 0; v < nv; ++v)
       if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
   }
+  // The fitting measures the quads as they will be split, and may change which split is closer.
+  if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(nullptr);
   if (options.fit_fraction > 0 && options.fit_rounds > 0) {
     std::vector<char> fit_frozen(nv, 0);
     for (int v = 0; v < nv; ++v)
       fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v];
+    const Eigen::MatrixX3d v_before = q.V;
     fit_to_surface(fit_frozen);
+    std::vector<char> moved(nv, 0);
+    for (int v = 0; v < nv; ++v) moved[v] = q.V.row(v) != v_before.row(v);
+    if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(&moved);
   }
   res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
   res.stats.n_flipped_after = count_bad(kFlipped);

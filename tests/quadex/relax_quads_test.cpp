@@ -1,6 +1,6 @@
 // relax_bad_quads: repairs reflex corners on a constructed planar grid and quads folded over a
 // crease, keeps vertices on the surface and the boundary fixed, leaves good meshes alone, rejects
-// bad input.
+// bad input; turns quads to the diagonal that follows the surface.
 #include <libquadex/quad_metrics.h>
 #include <libquadex/relax_quads.h>
 
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace quadify::quadex {
 namespace {
@@ -267,7 +268,10 @@ TEST(RelaxQuads, FittingBringsInATipTheQuadsCutOff) {
   EXPECT_EQ(kept.stats.n_fitted, 0);
   EXPECT_EQ(kept.quads.V, q.V);
 
-  const RelaxResult r = relax_bad_quads(q, surface);
+  // The fitting alone (the diagonal choice would make other positions the best).
+  RelaxOptions fit_only;
+  fit_only.choose_diagonals = false;
+  const RelaxResult r = relax_bad_quads(q, surface, fit_only);
   ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
   EXPECT_GE(r.stats.n_fitted, 1);
   EXPECT_LT(r.stats.fit_distance_after, 0.9 * r.stats.fit_distance_before);
@@ -287,6 +291,77 @@ TEST(RelaxQuads, FittingBringsInATipTheQuadsCutOff) {
     }
   }
   EXPECT_EQ(r.quads.face_vertex, q.face_vertex);
+
+  // With the diagonal choice (the default): the same quads, some starting at another corner,
+  // closer still.
+  const RelaxResult both = relax_bad_quads(q, surface);
+  ASSERT_TRUE(both.status.is_ok()) << both.status.to_string();
+  EXPECT_GE(both.stats.n_diagonals_turned, 1);
+  const QuadMetrics closer = compute_quad_metrics(both.quads, &surface);
+  EXPECT_LT(closer.hausdorff_sym, after.hausdorff_sym);
+  EXPECT_EQ(closer.n_flipped, 0);
+  ASSERT_EQ(both.quads.n_faces(), q.n_faces());
+  for (int f = 0; f < q.n_faces(); ++f) {
+    std::vector<int> a(q.face_vertex.begin() + q.face_offset[f], q.face_vertex.begin() + q.face_offset[f + 1]);
+    const std::vector<int> b(both.quads.face_vertex.begin() + both.quads.face_offset[f],
+                             both.quads.face_vertex.begin() + both.quads.face_offset[f + 1]);
+    bool rotation = false;
+    for (size_t k = 0; k < a.size() && !rotation; ++k) {
+      rotation = a == b;
+      std::rotate(a.begin(), a.begin() + 1, a.end());
+    }
+    EXPECT_TRUE(rotation) << "face " << f << " is not the same quad";
+  }
+}
+
+TEST(RelaxQuads, StartsAQuadAtTheCornerWhoseDiagonalFollowsTheSurface) {
+  // One quad A B C D on a surface folded along its diagonal B–D (two triangles, A B D and
+  // B C D): split from its first corner, (A,B,C) and (A,C,D), it cuts across the fold (the
+  // metrics see it up to 0.14 away from the surface); split from B it is the surface itself. The
+  // diagonal choice turns it to start at B, with its UVs, and nothing else changes; with the
+  // choice off, or on a surface folded along A–C, it stays as it is.
+  core::TriMesh roof;
+  roof.V.resize(4, 3);
+  roof.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0.5;
+  roof.F.resize(2, 3);
+  roof.F << 0, 1, 3, 1, 2, 3;
+  core::PolyMesh q;
+  q.V = roof.V;
+  q.uv.resize(4, 2);
+  q.uv << 0, 0, 1, 0, 1, 1, 0, 1;
+  q.add_face({0, 1, 2, 3}, {0, 1, 2, 3});
+  const QuadMetrics before = compute_quad_metrics(q, &roof);
+  ASSERT_GT(before.hausdorff_sym, 0.05);  // × bounding-box diagonal (1.5)
+
+  const RelaxResult r = relax_bad_quads(q, roof);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_diagonals_turned, 1);
+  EXPECT_EQ(r.quads.face_vertex, (std::vector<int>{1, 2, 3, 0}));
+  EXPECT_EQ(r.quads.face_uv, (std::vector<int>{1, 2, 3, 0}));
+  EXPECT_EQ(r.quads.V, q.V);
+  EXPECT_EQ(r.quads.uv, q.uv);
+  const QuadMetrics after = compute_quad_metrics(r.quads, &roof);
+  EXPECT_LT(after.hausdorff_sym, 1e-9);
+  EXPECT_EQ(after.n_flipped, 0);
+  EXPECT_NEAR(after.sj_min, before.sj_min, 1e-12);  // corners are the same
+
+  RelaxOptions off;
+  off.choose_diagonals = false;
+  const RelaxResult kept = relax_bad_quads(q, roof, off);
+  ASSERT_TRUE(kept.status.is_ok());
+  EXPECT_EQ(kept.stats.n_diagonals_turned, 0);
+  EXPECT_EQ(kept.quads.face_vertex, q.face_vertex);
+
+  core::TriMesh other = roof;  // folded along A–C: the first split is the surface already
+  other.V(3, 2) = 0;
+  other.V(2, 2) = 0.5;
+  other.F << 0, 1, 2, 0, 2, 3;
+  core::PolyMesh on_other = q;
+  on_other.V = other.V;
+  const RelaxResult same = relax_bad_quads(on_other, other);
+  ASSERT_TRUE(same.status.is_ok());
+  EXPECT_EQ(same.stats.n_diagonals_turned, 0);
+  EXPECT_EQ(same.quads.face_vertex, q.face_vertex);
 }
 
 TEST(RelaxQuads, RejectsBadInput) {

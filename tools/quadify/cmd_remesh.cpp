@@ -276,6 +276,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
                        {"fitted", relax_stats.n_fitted},
                        {"fit_distance_before", relax_stats.fit_distance_before},
                        {"fit_distance_after", relax_stats.fit_distance_after},
+                       {"diagonals_turned", relax_stats.n_diagonals_turned},
                        {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");
