@@ -55,6 +55,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <optional>
 #include <limits>
@@ -1090,6 +1091,52 @@ std::vector<std::array<int, 2>> features_for_density(
     if (length[r] >= min_quad_edges * h * (open[r] ? 1 : 4)) kept.push_back(e);
   }
   return kept;
+}
+
+CurveSummary summarize_curves(const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& edges,
+                              const QuantizeOptions& options, double knife_deg) {
+  CurveSummary out;
+  const int nv = mesh.n_vertices();
+  std::vector<int> parent(nv);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  // The faces on each edge (by its sorted vertex pair), for the dihedral angles.
+  std::map<std::pair<int, int>, std::vector<int>> edge_faces;
+  for (const auto& [a, b] : edges) {
+    if (a < 0 || b < 0 || a >= nv || b >= nv || a == b) continue;
+    parent[find(a)] = find(b);
+    edge_faces[{std::min(a, b), std::max(a, b)}];
+  }
+  if (edge_faces.empty()) return out;
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3);
+      const auto it = edge_faces.find({std::min(a, b), std::max(a, b)});
+      if (it != edge_faces.end()) it->second.push_back(f);
+    }
+  auto normal = [&](int f) {
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)), p2 = mesh.V.row(mesh.F(f, 2));
+    return (p1 - p0).cross(p2 - p0).normalized();
+  };
+  std::map<int, double> length;
+  std::map<int, std::vector<double>> angles;
+  for (const auto& [e, faces] : edge_faces) {
+    const int r = find(e.first);
+    length[r] += (mesh.V.row(e.first) - mesh.V.row(e.second)).norm();
+    if (faces.size() == 2)
+      angles[r].push_back(std::acos(std::clamp(normal(faces[0]).dot(normal(faces[1])), -1.0, 1.0)) * 180 /
+                          std::numbers::pi);
+  }
+  const double h = target_edge_length(mesh, options);
+  for (const auto& [r, l] : length) out.longest_quad_edges = std::max(out.longest_quad_edges, l / h);
+  for (auto& [r, a] : angles) {
+    std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+    if (a[a.size() / 2] >= knife_deg) out.has_knife_edge = true;
+  }
+  return out;
 }
 
 QuantizeResult quantize_seamless(const core::TriMesh& mesh, const param::ParamResult& seamless,

@@ -35,6 +35,9 @@ struct RemeshArgs {
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
   double time_budget = 0;         // seconds for the quantization, 0 = none
+  // Detected creases that are all shorter than this many target quad edges (no knife edge among
+  // them) are left out: an organic model's stray fragments. 0 = always aligned.
+  double min_crease_quads = 8;
   FeatureArgs features;
   SizingArgs sizing;
 };
@@ -83,6 +86,29 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &param_options);
+  // Stray creases: on a smooth model, the few sharp fragments the crease filter keeps (an ear's
+  // rim, a claw, a kink of the tessellation) are each a couple of quads long; they cannot shape
+  // the layout, yet aligning them adds cones and distortion, and on 100K-triangle models made
+  // the quantization dead-end after minutes (feline, armadillo), after which they were dropped
+  // anyway. They come first in feature_edges (the given edges follow).
+  {
+    const int n_creases = feature_input.n_detected - feature_input.n_not_creases;
+    if (args.min_crease_quads > 0 && n_creases > 0) {
+      const std::vector<std::array<int, 2>> creases(param_options.feature_edges.begin(),
+                                                    param_options.feature_edges.begin() + n_creases);
+      const quantize::CurveSummary curves = quantize::summarize_curves(mesh, creases, quantize_options);
+      if (curves.longest_quad_edges < args.min_crease_quads && !curves.has_knife_edge) {
+        param_options.feature_edges.erase(param_options.feature_edges.begin(),
+                                          param_options.feature_edges.begin() + n_creases);
+        feature_input.n_stray_creases = n_creases;
+        if (!common.quiet)
+          std::fprintf(stderr,
+                       "quadify: %s: the %d crease edges form only short curves (the longest %.1f quad "
+                       "edges, below --min-crease-quads %g): not aligned\n",
+                       args.input.c_str(), n_creases, curves.longest_quad_edges, args.min_crease_quads);
+      }
+    }
+  }
   const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   sizing.apply_to(&param_options);
   quantize_options.face_size = sizing.face_size;
@@ -355,6 +381,13 @@ CommandRunner register_remesh(CLI::App& app) {
                  "shorter than this many quad edge lengths (and at least 8 mean edge lengths of the input), "
                  "by changing the matchings along the path: such pairs cannot sit on distinct grid points "
                  "and add two irregular vertices (0 = keep every cone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--min-crease-quads", args->min_crease_quads,
+                 "Leave the detected creases unaligned when every crease curve is shorter than this "
+                 "many quad edges and none is a knife edge (median dihedral angle of at least 120 "
+                 "degrees): the stray sharp fragments of an organic model (an ear's rim, a claw), too "
+                 "short to shape the quads, which would add cones and distortion (0 = always align)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--time-budget", args->time_budget,

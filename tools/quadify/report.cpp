@@ -245,6 +245,7 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"given_edges", fi.n_given},
           {"given_edges_lost_in_repair", fi.n_lost},
           {"too_small_for_density", fi.n_too_small},
+          {"stray_creases", fi.n_stray_creases},
           {"wedges_flipped", fi.n_wedges_flipped},
           {"feature_edges", s.n_feature_edges},
           {"aligned", s.n_aligned_features},

@@ -106,6 +106,7 @@ struct FeatureInput {
   int n_given = 0;     // edges from the file and the OBJ lines
   int n_lost = 0;      // given edges that the repair removed (e.g. with a degenerate face)
   int n_too_small = 0;  // edges of curves too short for the quad density (remesh only)
+  int n_stray_creases = 0;  // creases left out as an organic model's stray fragments (remesh only)
   int n_wedges_flipped = 0;  // core::flip_feature_wedges on the repaired mesh
   bool soft = false;    // Alg. 3 (--feature-mode after)
 };

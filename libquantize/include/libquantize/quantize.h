@@ -132,6 +132,19 @@ inline constexpr int kRecommendedConePairHops = 6;
     const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& feature_edges,
     const QuantizeOptions& options, double min_quad_edges = 1);
 
+// The length of the longest curve (connected component) of `edges` (vertex-id pairs of `mesh`)
+// in target quad edges at `options`' density, and whether some curve is a knife edge (the median
+// dihedral angle of its edges, between their two faces, at least knife_deg degrees). The remesher
+// leaves out creases that are all shorter than a few quad edges and no knife edge: an organic
+// model's stray fragments (see RemeshArgs in the CLI).
+struct CurveSummary {
+  double longest_quad_edges = 0;
+  bool has_knife_edge = false;
+};
+[[nodiscard]] CurveSummary summarize_curves(const core::TriMesh& mesh,
+                                            const std::vector<std::array<int, 2>>& edges,
+                                            const QuantizeOptions& options, double knife_deg = 120);
+
 // Quantizes `seamless` (a result of param::compute_seamless_param for `mesh`, or any map with
 // seams listed with their matchings and every cone in seamless.cones) into an integer-seamless
 // map: greedy batch rounding of the independent integer unknowns, each batch followed by a
