@@ -402,12 +402,52 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     }
     return std::sqrt(worst);
   };
+  // Each surface sample's closest face (owner, -1 when there is no face) and its distance to it,
+  // the faces split as the metrics split them; false when there is no face.
+  auto assign_owners = [&](std::vector<int>* owner, std::vector<double>* dist) {
+    std::vector<Triangle> quad_tris;
+    std::vector<int> quad_of;
+    for (int f = 0; f < nf; ++f)  // every face: samples under a polygon are not a quad's
+      for (int t = 0; t + 2 < q.degree(f); ++t) {
+        quad_tris.push_back(quad_triangle(f, t));
+        quad_of.push_back(f);
+      }
+    owner->assign(ns, -1);
+    dist->assign(ns, 0);
+    if (quad_tris.empty()) return false;
+    TriangleTree quad_tree(quad_tris.begin(), quad_tris.end());
+    quad_tree.accelerate_distance_queries();
+    parallel_for_each_index(static_cast<size_t>(ns), [&](size_t s) {
+      const Point p(samples[s].x(), samples[s].y(), samples[s].z());
+      const auto hit = quad_tree.closest_point_and_primitive(p);
+      (*owner)[s] = quad_of[static_cast<size_t>(hit.second - quad_tris.cbegin())];
+      (*dist)[s] = std::sqrt(CGAL::squared_distance(p, hit.first));
+    });
+    return true;
+  };
   // Diagonal choice (see RelaxOptions::choose_diagonals): a quad whose split along its other
-  // diagonal (1,2,3), (1,3,0) lies closer to the surface, by more than kDiagonalGain, and whose
-  // two triangles of that split face the same way (the other split of a non-convex quad
-  // overlaps itself), starts at its next corner; only the quads with a vertex in `moved`, when
-  // given. Returns the quads turned.
+  // diagonal (1,2,3), (1,3,0) lies closer to the surface, both ways (its samples' distance to
+  // the surface, and the distance of the surface samples it owns to it), by more than
+  // kDiagonalGain, and whose two triangles of that split face the same way (the other split of
+  // a non-convex quad overlaps itself), starts at its next corner; only the quads with a vertex
+  // in `moved`, when given. Returns the quads turned.
   auto choose_diagonals = [&](const std::vector<char>* moved) {
+    std::vector<int> owner;
+    std::vector<double> owner_dist;
+    if (!assign_owners(&owner, &owner_dist)) return 0;
+    std::vector<std::vector<int>> owned(nf);
+    for (int s = 0; s < ns; ++s)
+      if (owner[s] >= 0) owned[owner[s]].push_back(s);
+    // The two-sided distance between quad f split from corner `first` and the surface.
+    auto split_distance = [&](int f, int first) {
+      double d = quad_distance(f, kDiagonalSamples, first);
+      const Triangle a = quad_triangle(f, 0, first), b = quad_triangle(f, 1, first);
+      for (const int s : owned[f]) {
+        const Point p(samples[s].x(), samples[s].y(), samples[s].z());
+        d = std::max(d, std::sqrt(std::min(CGAL::squared_distance(p, a), CGAL::squared_distance(p, b))));
+      }
+      return d;
+    };
     std::vector<char> turn(nf, 0);
     parallel_for_each_index(static_cast<size_t>(nf), [&](size_t fi) {
       const int f = static_cast<int>(fi);
@@ -419,8 +459,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       if (CGAL::scalar_product(a.supporting_plane().orthogonal_vector(),
                                b.supporting_plane().orthogonal_vector()) <= 0)
         return;
-      if (quad_distance(f, kDiagonalSamples, 1) < (1 - kDiagonalGain) * quad_distance(f, kDiagonalSamples, 0))
-        turn[fi] = 1;
+      if (split_distance(f, 1) < (1 - kDiagonalGain) * split_distance(f, 0)) turn[fi] = 1;
     });
     int n = 0;
     for (int f = 0; f < nf; ++f)
@@ -453,22 +492,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     std::vector<int> owner(ns, -1);
     double threshold = 0;  // local distances above it are fitted
     for (int round = 0; round < options.fit_rounds; ++round) {
-      std::vector<Triangle> quad_tris;
-      std::vector<int> quad_of;
-      for (int f = 0; f < nf; ++f)  // every face: samples under a polygon are not a quad's
-        for (int t = 0; t + 2 < q.degree(f); ++t) {
-          quad_tris.push_back(quad_triangle(f, t));
-          quad_of.push_back(f);
-        }
-      if (quad_tris.empty()) return;
-      TriangleTree quad_tree(quad_tris.begin(), quad_tris.end());
-      quad_tree.accelerate_distance_queries();
-      parallel_for_each_index(static_cast<size_t>(ns), [&](size_t s) {
-        const Point p(samples[s].x(), samples[s].y(), samples[s].z());
-        const auto hit = quad_tree.closest_point_and_primitive(p);
-        owner[s] = quad_of[static_cast<size_t>(hit.second - quad_tris.cbegin())];
-        sample_dist[s] = std::sqrt(CGAL::squared_distance(p, hit.first));
-      });
+      if (!assign_owners(&owner, &sample_dist)) return;
       parallel_for_each_index(static_cast<size_t>(nf), [&](size_t f) {
         quad_dist[f] = q.degree(static_cast<int>(f)) == 4 ? quad_distance(static_cast<int>(f)) : 0.0;
       });
