@@ -1,5 +1,6 @@
 // Tests of the small libcore pieces: mesh.h conversions, topology.h, predicates.h,
 // sparse_solver.h, atomic_file.h, status.h.
+#include "test_meshes.h"
 #include "test_util.h"
 #include "writer_samples.h"
 
@@ -230,27 +231,7 @@ TEST(TopologyTest, CreaseFilterLeavesOutTheSharpEdgesOfAnOrganicMesh) {
   EXPECT_TRUE(crease_edges(spot, topo, strict).empty()) << "no sharp edge of spot has flat sides";
 }
 
-// Two flat strips of n squares along x meeting at the edge y = z = 0: the top (y from 0 to 1,
-// z = 0) and one opening by `opening` degrees below it (a blade's edge for a small opening).
-TriMesh folded_strips(int n, double opening) {
-  const double a = opening * std::numbers::pi / 180;
-  TriMesh m;
-  m.V.resize(3 * (n + 1), 3);
-  for (int i = 0; i <= n; ++i) {
-    m.V.row(i) << i, 0, 0;                                        // edge
-    m.V.row(n + 1 + i) << i, 1, 0;                                // top
-    m.V.row(2 * (n + 1) + i) << i, std::cos(a), -std::sin(a);     // underside
-  }
-  m.F.resize(4 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    const int e = i, t = n + 1 + i, u = 2 * (n + 1) + i;
-    m.F.row(4 * i) << e, e + 1, t + 1;
-    m.F.row(4 * i + 1) << e, t + 1, t;
-    m.F.row(4 * i + 2) << e + 1, e, u;
-    m.F.row(4 * i + 3) << e + 1, u, u + 1;
-  }
-  return m;
-}
+using test::folded_strips;
 
 TEST(TopologyTest, AShortKnifeEdgeIsACreaseAShortFoldIsNot) {
   // Three sharp edges with flat sides: too few for a group, unless they are a knife edge.

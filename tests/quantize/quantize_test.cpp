@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "quantize_test_util.h"
+#include "test_meshes.h"
 #include "test_util.h"
 
 namespace quadify {
@@ -202,29 +203,6 @@ TEST(QuantizeSeamless, EdgeLengthSetsTheScale) {
   EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
 }
 
-// A strip folded along the x axis: the fold line's n + 1 vertices, one side in the plane z = 0
-// (y = 1), the other at opening angle `opening_deg` from it; the fold edges have dihedral angle
-// 180° − opening.
-core::TriMesh folded_strip(int n, double opening_deg) {
-  const double phi = opening_deg * std::numbers::pi / 180;
-  core::TriMesh m;
-  m.V.resize(3 * (n + 1), 3);
-  for (int i = 0; i <= n; ++i) {
-    m.V.row(i) << i, 0, 0;
-    m.V.row(n + 1 + i) << i, 1, 0;
-    m.V.row(2 * (n + 1) + i) << i, std::cos(phi), std::sin(phi);
-  }
-  m.F.resize(4 * n, 3);
-  for (int i = 0; i < n; ++i) {
-    const int l = i, a = n + 1 + i, b = 2 * (n + 1) + i;
-    m.F.row(4 * i) << l, l + 1, a + 1;
-    m.F.row(4 * i + 1) << l, a + 1, a;
-    m.F.row(4 * i + 2) << l + 1, l, b;
-    m.F.row(4 * i + 3) << l + 1, b, b + 1;
-  }
-  return m;
-}
-
 TEST(QuantizeCurves, LongestCurveInQuadEdgesAndKnifeEdges) {
   // The fold line of 4 unit edges at quad edge 0.5 is 8 quad edges long; split into two pieces
   // of one edge each, 2. A fold of 150° (opening 30°) is a knife edge, one of 60° is not.
@@ -232,7 +210,7 @@ TEST(QuantizeCurves, LongestCurveInQuadEdgesAndKnifeEdges) {
   qo.edge_length = 0.5;
   const std::vector<std::array<int, 2>> line = {{0, 1}, {1, 2}, {2, 3}, {3, 4}};
   const std::vector<std::array<int, 2>> pieces = {{0, 1}, {2, 3}};
-  const core::TriMesh knife = folded_strip(4, 30), fold = folded_strip(4, 120);
+  const core::TriMesh knife = test::folded_strips(4, 30), fold = test::folded_strips(4, 120);
   const quantize::CurveSummary a = quantize::summarize_curves(knife, line, qo);
   EXPECT_NEAR(a.longest_quad_edges, 8, 1e-12);
   EXPECT_TRUE(a.has_knife_edge);
