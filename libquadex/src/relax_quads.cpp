@@ -456,8 +456,9 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
           !(*moved)[q.vertex(f, 3)])
         return;
       const Triangle a = quad_triangle(f, 0, 1), b = quad_triangle(f, 1, 1);
-      if (CGAL::scalar_product(a.supporting_plane().orthogonal_vector(),
-                               b.supporting_plane().orthogonal_vector()) <= 0)
+      // (Cross products, not supporting planes: a degenerate quad has no plane.)
+      if (CGAL::scalar_product(CGAL::cross_product(a[1] - a[0], a[2] - a[0]),
+                               CGAL::cross_product(b[1] - b[0], b[2] - b[0])) <= 0)
         return;
       if (split_distance(f, 1) < (1 - kDiagonalGain) * split_distance(f, 0)) turn[fi] = 1;
     });

@@ -362,6 +362,13 @@ TEST(RelaxQuads, StartsAQuadAtTheCornerWhoseDiagonalFollowsTheSurface) {
   ASSERT_TRUE(same.status.is_ok());
   EXPECT_EQ(same.stats.n_diagonals_turned, 0);
   EXPECT_EQ(same.quads.face_vertex, q.face_vertex);
+
+  core::PolyMesh degenerate = q;  // D on A: the other split has a triangle of zero area
+  degenerate.V.row(3) = degenerate.V.row(0);
+  const RelaxResult kept_degenerate = relax_bad_quads(degenerate, roof);
+  ASSERT_TRUE(kept_degenerate.status.is_ok()) << kept_degenerate.status.to_string();
+  EXPECT_EQ(kept_degenerate.stats.n_diagonals_turned, 0);
+  EXPECT_EQ(kept_degenerate.quads.face_vertex, q.face_vertex);
 }
 
 TEST(RelaxQuads, RejectsBadInput) {
