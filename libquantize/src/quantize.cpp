@@ -1059,43 +1059,17 @@ double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeO
   return std::max(quad_edges * target_edge_length(mesh, options), kConePairMeshEdges * mean_edge);
 }
 
-std::vector<std::array<int, 2>> features_for_density(
-    const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& feature_edges,
-    const QuantizeOptions& options, double min_quad_edges) {
-  const int nv = mesh.n_vertices();
-  std::vector<int> parent(nv), degree(nv, 0);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& [a, b] : feature_edges) {
-    if (a < 0 || b < 0 || a >= nv || b >= nv) continue;
-    ++degree[a];
-    ++degree[b];
-    parent[find(a)] = find(b);
-  }
-  std::vector<double> length(nv, 0);
-  std::vector<char> open(nv, 0);
-  for (const auto& [a, b] : feature_edges) {
-    if (a < 0 || b < 0 || a >= nv || b >= nv) continue;
-    const int r = find(a);
-    length[r] += (mesh.V.row(a) - mesh.V.row(b)).norm();
-    if (degree[a] != 2 || degree[b] != 2) open[r] = 1;
-  }
-  const double h = target_edge_length(mesh, options);
-  std::vector<std::array<int, 2>> kept;
-  for (const auto& e : feature_edges) {
-    if (e[0] < 0 || e[1] < 0 || e[0] >= nv || e[1] >= nv) continue;
-    const int r = find(e[0]);
-    if (length[r] >= min_quad_edges * h * (open[r] ? 1 : 4)) kept.push_back(e);
-  }
-  return kept;
-}
+namespace {
 
-CurveSummary summarize_curves(const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& edges,
-                              const QuantizeOptions& options, double knife_deg) {
-  CurveSummary out;
+// The curves (connected components) of `edges`, vertex-id pairs of `mesh`: each edge's curve (a
+// root vertex; -1 for an edge with a vertex out of range) and each curve's length in model units
+// (indexed by its root vertex; every listed edge counts).
+struct Curves {
+  std::vector<int> edge_curve;
+  std::vector<double> length;
+};
+
+Curves find_curves(const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& edges) {
   const int nv = mesh.n_vertices();
   std::vector<int> parent(nv);
   std::iota(parent.begin(), parent.end(), 0);
@@ -1103,13 +1077,58 @@ CurveSummary summarize_curves(const core::TriMesh& mesh, const std::vector<std::
     while (parent[v] != v) v = parent[v] = parent[parent[v]];
     return v;
   };
+  auto valid = [&](const std::array<int, 2>& e) { return e[0] >= 0 && e[1] >= 0 && e[0] < nv && e[1] < nv; };
+  for (const auto& e : edges)
+    if (valid(e)) parent[find(e[0])] = find(e[1]);
+  Curves c;
+  c.edge_curve.assign(edges.size(), -1);
+  c.length.assign(nv, 0);
+  for (size_t i = 0; i < edges.size(); ++i)
+    if (valid(edges[i])) {
+      const int r = c.edge_curve[i] = find(edges[i][0]);
+      c.length[r] += (mesh.V.row(edges[i][0]) - mesh.V.row(edges[i][1])).norm();
+    }
+  return c;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> features_for_density(
+    const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& feature_edges,
+    const QuantizeOptions& options, double min_quad_edges) {
+  const Curves curves = find_curves(mesh, feature_edges);
+  std::vector<int> degree(mesh.n_vertices(), 0);
+  for (size_t i = 0; i < feature_edges.size(); ++i)
+    if (curves.edge_curve[i] >= 0) {
+      ++degree[feature_edges[i][0]];
+      ++degree[feature_edges[i][1]];
+    }
+  std::vector<char> open(mesh.n_vertices(), 0);
+  for (size_t i = 0; i < feature_edges.size(); ++i)
+    if (curves.edge_curve[i] >= 0 && (degree[feature_edges[i][0]] != 2 || degree[feature_edges[i][1]] != 2))
+      open[curves.edge_curve[i]] = 1;
+  const double h = target_edge_length(mesh, options);
+  std::vector<std::array<int, 2>> kept;
+  for (size_t i = 0; i < feature_edges.size(); ++i) {
+    const int r = curves.edge_curve[i];
+    if (r >= 0 && curves.length[r] >= min_quad_edges * h * (open[r] ? 1 : 4)) kept.push_back(feature_edges[i]);
+  }
+  return kept;
+}
+
+CurveSummary summarize_curves(const core::TriMesh& mesh, const std::vector<std::array<int, 2>>& edges,
+                              const QuantizeOptions& options, double knife_deg) {
+  CurveSummary out;
+  const Curves curves = find_curves(mesh, edges);
   // The faces on each edge (by its sorted vertex pair), for the dihedral angles.
   std::map<std::pair<int, int>, std::vector<int>> edge_faces;
-  for (const auto& [a, b] : edges) {
-    if (a < 0 || b < 0 || a >= nv || b >= nv || a == b) continue;
-    parent[find(a)] = find(b);
-    edge_faces[{std::min(a, b), std::max(a, b)}];
-  }
+  std::map<std::pair<int, int>, int> edge_curve;
+  for (size_t i = 0; i < edges.size(); ++i)
+    if (curves.edge_curve[i] >= 0) {
+      const std::pair<int, int> key{std::min(edges[i][0], edges[i][1]), std::max(edges[i][0], edges[i][1])};
+      edge_faces[key];
+      edge_curve[key] = curves.edge_curve[i];
+    }
   if (edge_faces.empty()) return out;
   for (int f = 0; f < mesh.n_faces(); ++f)
     for (int k = 0; k < 3; ++k) {
@@ -1121,17 +1140,13 @@ CurveSummary summarize_curves(const core::TriMesh& mesh, const std::vector<std::
     const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)), p2 = mesh.V.row(mesh.F(f, 2));
     return (p1 - p0).cross(p2 - p0).normalized();
   };
-  std::map<int, double> length;
   std::map<int, std::vector<double>> angles;
-  for (const auto& [e, faces] : edge_faces) {
-    const int r = find(e.first);
-    length[r] += (mesh.V.row(e.first) - mesh.V.row(e.second)).norm();
+  for (const auto& [e, faces] : edge_faces)
     if (faces.size() == 2)
-      angles[r].push_back(std::acos(std::clamp(normal(faces[0]).dot(normal(faces[1])), -1.0, 1.0)) * 180 /
-                          std::numbers::pi);
-  }
+      angles[edge_curve[e]].push_back(
+          std::acos(std::clamp(normal(faces[0]).dot(normal(faces[1])), -1.0, 1.0)) * 180 / std::numbers::pi);
   const double h = target_edge_length(mesh, options);
-  for (const auto& [r, l] : length) out.longest_quad_edges = std::max(out.longest_quad_edges, l / h);
+  for (const double l : curves.length) out.longest_quad_edges = std::max(out.longest_quad_edges, l / h);
   for (auto& [r, a] : angles) {
     std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
     if (a[a.size() / 2] >= knife_deg) out.has_knife_edge = true;
