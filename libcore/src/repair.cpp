@@ -1,7 +1,7 @@
 // repair_mesh: polygon soup → manifold, consistently oriented triangle mesh. Steps, in order:
 // triangulate, drop invalid faces, weld (hash grid), drop collapsed faces, remove zero-area
 // triangles by splitting their neighbour (keeps closed surfaces closed), drop duplicate faces,
-// split non-manifold edges and vertices (one vertex copy per fan), orient components, drop
+// remove fins (small flaps hanging on non-manifold edges), split non-manifold edges and vertices (one vertex copy per fan), orient components, drop
 // unreferenced vertices, check with build_edge_topology.
 #include <libcore/repair.h>
 
@@ -172,6 +172,10 @@ class Repairer {
       return result;
     }
     compact_faces();
+    if (opt_.max_fin_faces > 0) {
+      remove_fins(&rep);
+      compact_faces();
+    }
     if (opt_.split_nonmanifold_edges || opt_.split_nonmanifold_vertices) split_nonmanifold(&rep);
     if (opt_.orient_components) {
       Status s = orient(&rep);
@@ -431,6 +435,66 @@ class Repairer {
     return id;
   }
 
+  // Fins: a small patch of faces (connected through edges with exactly two faces) that hangs on
+  // edges with more than two faces and has a free boundary, such that without it each of those
+  // edges keeps exactly two faces (a scan's flap glued to a crease, a stray triangle across a
+  // corner). Removed: detaching it instead would leave a slit in the surface or a loose flap.
+  void remove_fins(RepairReport* rep) {
+    const int nf = static_cast<int>(tris_.size());
+    const EdgeIndex edges(tris_);
+    DisjointSets patch(nf);
+    edges.for_each_edge([&](long long, auto first, auto last) {
+      if (last - first == 2) patch.unite(first->second, (first + 1)->second);
+    });
+    std::vector<int> size(nf, 0);
+    std::vector<char> free_edge(nf, 0), on_nonmanifold(nf, 0);
+    for (int f = 0; f < nf; ++f) ++size[patch.find(f)];
+    edges.for_each_edge([&](long long, auto first, auto last) {
+      for (auto it = first; it != last; ++it) {
+        const int root = patch.find(it->second);
+        if (last - first == 1) free_edge[root] = 1;
+        if (last - first > 2) on_nonmanifold[root] = 1;
+      }
+    });
+    std::vector<char> candidate(nf, 0);
+    for (int f = 0; f < nf; ++f) {
+      const int root = patch.find(f);
+      candidate[f] = root == f && free_edge[root] && on_nonmanifold[root] &&
+                     size[root] <= opt_.max_fin_faces && 2 * size[root] < nf;
+    }
+    // Each non-manifold edge must keep exactly two faces: a patch is removed only if every such
+    // edge it touches has exactly two faces outside the removed patches, and no other fin on it.
+    for (bool changed = true; changed;) {
+      changed = false;
+      std::vector<char> keep(nf, 0);
+      edges.for_each_edge([&](long long, auto first, auto last) {
+        if (last - first <= 2) return;
+        std::vector<int> fins;
+        int outside = 0;
+        for (auto it = first; it != last; ++it) {
+          const int root = patch.find(it->second);
+          if (!candidate[root]) {
+            ++outside;
+          } else if (std::find(fins.begin(), fins.end(), root) == fins.end()) {
+            fins.push_back(root);
+          }
+        }
+        if (outside != 2 || fins.size() > 1)
+          for (const int r : fins) keep[r] = 1;
+      });
+      for (int f = 0; f < nf; ++f)
+        if (keep[f] && candidate[f]) {
+          candidate[f] = 0;
+          changed = true;
+        }
+    }
+    for (int f = 0; f < nf; ++f)
+      if (candidate[patch.find(f)]) {
+        alive_[f] = 0;
+        ++rep->fin_faces_removed;
+      }
+  }
+
   // Faces of a non-manifold edge beyond one pair are cut off the edge; then every vertex gets one
   // copy per fan (faces around it connected through uncut edges). A second round gives cut faces
   // private corners on edges still shared by more than two faces (fans joined elsewhere).
@@ -609,7 +673,7 @@ class Repairer {
 
 bool RepairReport::changed() const {
   return polygons_triangulated || invalid_faces_removed || welded_vertices ||
-         degenerate_faces_removed || caps_removed || folds_flipped || duplicate_faces_removed ||
+         degenerate_faces_removed || caps_removed || folds_flipped || fin_faces_removed || duplicate_faces_removed ||
          unreferenced_vertices_removed || faces_reoriented || nonmanifold_edges_split || nonmanifold_vertices_split;
 }
 

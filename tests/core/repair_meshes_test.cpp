@@ -45,17 +45,29 @@ TEST(RepairSlow, EveryBenchmarkMesh) {
     EXPECT_TRUE(s.is_manifold()) << path;
     EXPECT_NO_THROW((void)build_edge_topology(r.mesh)) << path;
     std::printf("%-28s V %d->%d F %d->%d weld %d degen %d dup %d invalid %d unref %d flip %d "
-                "nmE %d nmV %d | comps %d loops %d chi %d genus %d | %.2fs\n",
+                "fins %d nmE %d nmV %d | comps %d loops %d chi %d genus %d | %.2fs\n",
                 path.filename().c_str(), p.input_vertices, p.output_vertices, p.input_faces,
                 p.output_faces, p.welded_vertices, p.degenerate_faces_removed,
                 p.duplicate_faces_removed, p.invalid_faces_removed,
-                p.unreferenced_vertices_removed, p.faces_reoriented, p.nonmanifold_edges_split,
+                p.unreferenced_vertices_removed, p.faces_reoriented, p.fin_faces_removed, p.nonmanifold_edges_split,
                 p.nonmanifold_vertices_split, s.n_components, s.n_boundary_loops,
                 s.euler_characteristic, s.genus, sec);
     if (path.filename() == "fandisk_degenerate.obj") {
       EXPECT_EQ(s.n_boundary_loops, 0) << "fandisk_degenerate must stay closed";
       EXPECT_EQ(s.genus, 0);
       EXPECT_EQ(s.n_components, 1);
+    }
+    // Fins (flaps and stray triangles on non-manifold edges) are removed, not detached: the
+    // surfaces stay closed and whole.
+    if (path.filename() == "dragon.obj" || path.filename() == "crank.obj") {
+      EXPECT_GT(p.fin_faces_removed, 0) << path;
+      EXPECT_EQ(s.n_boundary_loops, 0) << path;
+      EXPECT_EQ(s.n_components, 1) << path;
+    }
+    if (path.filename() == "spot_nonmanifold.obj") {
+      EXPECT_EQ(p.fin_faces_removed, 3);
+      EXPECT_EQ(s.n_boundary_loops, 0);
+      EXPECT_EQ(s.n_components, 2) << "spot and the tetrahedron at its non-manifold vertex";
     }
   }
 }

@@ -269,20 +269,69 @@ TEST(Repair, DuplicateFaceAndInvalidFaceAndIsolatedVertices) {
   for (int v = 0; v < 8; ++v) EXPECT_EQ(r.vertex_origin[v], v);
 }
 
-TEST(Repair, NonManifoldFinEdgeIsDetached) {
+TEST(Repair, NonManifoldFinIsRemoved) {
   PolyMesh m = cube_tris();
   m.V.conservativeResize(9, 3);
   m.V.row(8) << -1, 0.5, 0.5;
   m.add_face({0, 1, 8});  // a fin on cube edge (0,1): three faces on the edge
   const RepairResult r = repair_mesh(m);
   ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  expect_closed_genus(r, 1, 0, "fin");
+  EXPECT_EQ(r.report.fin_faces_removed, 1);
+  EXPECT_EQ(r.report.nonmanifold_edges_split, 0);
+  EXPECT_EQ(r.mesh.n_faces(), 12);
+  EXPECT_EQ(r.mesh.n_vertices(), 8);  // the fin's tip is unreferenced now
+}
+
+TEST(Repair, NonManifoldFinEdgeIsDetachedWhenFinsAreKept) {
+  PolyMesh m = cube_tris();
+  m.V.conservativeResize(9, 3);
+  m.V.row(8) << -1, 0.5, 0.5;
+  m.add_face({0, 1, 8});
+  RepairOptions options;
+  options.max_fin_faces = 0;
+  const RepairResult r = repair_mesh(m, options);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
   const TopologyStats s = topology_stats(r.mesh);
   EXPECT_TRUE(s.is_manifold()) << s.n_nonmanifold_edges << " " << s.n_nonmanifold_vertices;
   EXPECT_EQ(s.n_components, 2);
   EXPECT_EQ(s.n_boundary_loops, 1);  // the detached fin
+  EXPECT_EQ(r.report.fin_faces_removed, 0);
   EXPECT_EQ(r.report.nonmanifold_edges_split, 1);
   EXPECT_EQ(r.mesh.n_faces(), 13);
   EXPECT_EQ(r.mesh.n_vertices(), 11);  // fin gets copies of 0 and 1
+}
+
+TEST(Repair, TriangleAcrossACornerIsRemoved) {
+  // A stray triangle (q1, q2, q3) over two edges of the cube's quad q, triangulated (q0, q1, q2),
+  // (q0, q2, q3): both of its cube edges get three faces, its third edge is free. Without it the
+  // cube is closed again; detaching it would leave a slit.
+  PolyMesh m = cube_tris();
+  const std::vector<int>& q = kCubeQuads[0];
+  m.add_face({q[1], q[2], q[3]});
+  const RepairResult r = repair_mesh(m);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  expect_closed_genus(r, 1, 0, "corner triangle");
+  EXPECT_EQ(r.report.fin_faces_removed, 1);
+  EXPECT_EQ(r.report.nonmanifold_edges_split, 0);
+  EXPECT_EQ(r.mesh.n_faces(), 12);
+}
+
+TEST(Repair, TwoSolidsOnAnEdgeAreDetachedNotRemoved) {
+  // Two cubes sharing an edge: neither is a fin (no free boundary, and too big).
+  PolyMesh m = cube_tris();
+  const int n = m.n_vertices();
+  PolyMesh other = cube_tris();
+  m.V.conservativeResize(2 * n, 3);
+  for (int v = 0; v < n; ++v) m.V.row(n + v) = other.V.row(v) + Eigen::RowVector3d(1, 1, 0);
+  for (int f = 0; f < other.n_faces(); ++f)
+    m.add_face({other.vertex(f, 0) + n, other.vertex(f, 1) + n, other.vertex(f, 2) + n});
+  // Cube 2's corners (1, 1, z) coincide with cube 1's and are welded: edge (6, 7) has 4 faces.
+  const RepairResult r = repair_mesh(m);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.report.fin_faces_removed, 0);
+  EXPECT_EQ(r.mesh.n_faces(), 24);
+  EXPECT_TRUE(topology_stats(r.mesh).is_manifold());
 }
 
 TEST(Repair, BowtieVertexIsSplit) {

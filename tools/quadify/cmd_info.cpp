@@ -45,10 +45,10 @@ int run_info(const std::string& input, const CommonOptions& common) {
               input.c_str(), loaded.raw.n_vertices(), loaded.raw.n_faces(), raw_stats.n_nonmanifold_edges,
               raw_stats.n_nonmanifold_vertices);
   std::printf("repair: %d polygons triangulated, %d invalid faces, %d vertices welded, %d degenerate faces, "
-              "%d caps, %d folds flipped, %d duplicate faces, %d unreferenced vertices, %d faces reoriented, %d non-manifold edges and "
+              "%d caps, %d folds flipped, %d fin faces, %d duplicate faces, %d unreferenced vertices, %d faces reoriented, %d non-manifold edges and "
               "%d vertices split\n",
               r.polygons_triangulated, r.invalid_faces_removed, r.welded_vertices, r.degenerate_faces_removed,
-              r.caps_removed, r.folds_flipped, r.duplicate_faces_removed, r.unreferenced_vertices_removed, r.faces_reoriented,
+              r.caps_removed, r.folds_flipped, r.fin_faces_removed, r.duplicate_faces_removed, r.unreferenced_vertices_removed, r.faces_reoriented,
               r.nonmanifold_edges_split, r.nonmanifold_vertices_split);
   std::printf("repaired: %d vertices, %d triangles, %d components, %d boundary loops, chi %d, genus %s\n",
               stats.n_vertices, stats.n_faces, stats.n_components, stats.n_boundary_loops,

@@ -268,6 +268,7 @@ nlohmann::json to_json(const core::RepairReport& r) {
           {"degenerate_faces_removed", r.degenerate_faces_removed},
           {"caps_removed", r.caps_removed},
           {"folds_flipped", r.folds_flipped},
+          {"fin_faces_removed", r.fin_faces_removed},
           {"duplicate_faces_removed", r.duplicate_faces_removed},
           {"unreferenced_vertices_removed", r.unreferenced_vertices_removed},
           {"faces_reoriented", r.faces_reoriented},

@@ -31,6 +31,11 @@ struct RepairOptions {
   // curves. The edge is flipped when the two new triangles agree (normals within 30°): the
   // double-covered sliver disappears and the surface is as before. 180 = off.
   double fold_angle_deg = 150;
+  // Fins: patches of at most this many faces (connected through manifold edges) that hang on
+  // non-manifold edges with a free boundary, and without which those edges have exactly two
+  // faces, are removed (a flap of a scan glued to the surface, a stray triangle across a corner);
+  // larger ones are detached by split_nonmanifold_edges. 0 = detach them all.
+  int max_fin_faces = 16;
   bool orient_components = true;          // make each component consistently oriented
   bool split_nonmanifold_vertices = true;  // give each fan of a non-manifold vertex its own copy
   bool split_nonmanifold_edges = true;     // detach faces beyond a consistent pair on an edge
@@ -46,6 +51,7 @@ struct RepairReport {
   int degenerate_faces_removed = 0;     // zero-area (collinear or collapsed) triangles
   int caps_removed = 0;                 // caps (see RepairOptions::cap_angle_deg)
   int folds_flipped = 0;                // edges of folded triangle pairs flipped
+  int fin_faces_removed = 0;            // faces of fins (see RepairOptions::max_fin_faces)
   int duplicate_faces_removed = 0;      // same vertex set as an earlier face
   int unreferenced_vertices_removed = 0;
   int faces_reoriented = 0;             // flipped to agree with their component
