@@ -41,7 +41,11 @@ void limit_library_threads() {
 struct SparseSolver::Impl {
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower> simplicial;
 #ifdef QUADIFY_WITH_CHOLMOD
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> supernodal;
+  // The upper triangle: with a fill-reducing permutation CHOLMOD's supernodal factorization
+  // makes S = tril(P·A·Pᵀ) from an upper-stored A in one transpose, from a lower-stored one in
+  // two (cholmod_factorize.c); both triangles are stored, so either view is the same matrix.
+  // Measured: see the README design note on the sparse solver.
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> supernodal;
 #endif
   bool use_supernodal = false;
   bool analyzed = false;
