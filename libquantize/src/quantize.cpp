@@ -22,7 +22,8 @@
 //    energy step); targets whose faces limit every step (a collision, a squeezed region) are
 //    dropped and try other free grid points (or the other neighbouring integer) one at a time.
 //    A run that still dead-ends restarts at nearby scales (×1 ± 2%, ±4%), then at scales grown
-//    by ×1.25 (max_scale_retries times). options.time_budget_seconds bounds the whole.
+//    by ×1.25 (max_scale_retries times). options.time_budget_seconds bounds the whole,
+//    options.feature_time_budget_seconds the attempts with aligned features.
 //    Aligned feature lines are optional candidates. They are rounded after the cones and before
 //    the translations (they get the first choice of the room), and a line that reaches no integer
 //    is released. If a translation then dead-ends (pinned lines in its way), the run is repeated
@@ -695,6 +696,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       options.threshold_step > 0.5 || !(options.scale_growth > 1) ||
       options.max_scale_retries < 0 || options.near_scale_tries < 0 ||
       options.feature_release_rounds < 0 || !(options.time_budget_seconds >= 0) ||
+      !(options.feature_time_budget_seconds >= 0) ||
       !(options.near_scale_step >= 0 && options.near_scale_step < 0.2)) {
     out.status = core::Status::invalid_input(
         "quantize options: need target_faces ≥ 0, edge_length ≥ 0, 0 < threshold_step ≤ 0.5, "
@@ -845,6 +847,11 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
           ? t0 + std::chrono::duration_cast<Clock::duration>(
                      std::chrono::duration<double>(options.time_budget_seconds))
           : Clock::time_point::max();
+  const Clock::time_point feature_deadline =
+      options.feature_time_budget_seconds > 0
+          ? std::min(deadline, t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(
+                                        options.feature_time_budget_seconds)))
+          : deadline;
   std::optional<Eigen::VectorXd> best;
   core::Status failure;
   std::string last_stuck;
@@ -935,13 +942,26 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     std::snprintf(label, sizeof label, "x%.3f%s", scale / scales[0],
                   with_features ? (attempts[attempt].features_last ? " features-last" : "")
                                 : (feature_rows.empty() ? "" : " no-features"));
-    Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st, deadline, label,
+    Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st,
+                    with_features ? feature_deadline : deadline, label,
                     attempts[attempt].features_last, with_features ? release : ReleaseFeatures{});
     const Rounder::Outcome outcome = rounder.run(x, lopt);
     st.n_integer_dofs = rounder.n_integer_columns();
     if (outcome == Rounder::Outcome::kFailed) {
       failure = rounder.status();
       break;
+    }
+    if (outcome == Rounder::Outcome::kOutOfTime && with_features && feature_deadline < deadline) {
+      // The features' own budget: they count as not fitting; the attempts without them follow.
+      char msg[256];
+      std::snprintf(msg, sizeof msg,
+                    "the rounding with the aligned features exceeded its time budget of %.0f s "
+                    "(%d of %d integer unknowns rounded)",
+                    options.feature_time_budget_seconds, rounder.n_pinned(), rounder.n_integer_columns());
+      last_stuck = msg;
+      st.features_dropped_reason = msg;
+      while (attempt + 1 < static_cast<int>(attempts.size()) && attempts[attempt + 1].with_features) ++attempt;
+      continue;
     }
     if (outcome == Rounder::Outcome::kOutOfTime) {
       char msg[512];

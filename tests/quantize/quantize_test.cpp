@@ -123,6 +123,32 @@ TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
   EXPECT_LT(qm.hausdorff_sym, 1e-9) << "quads on the box's flat sides";
 }
 
+// The features' own time budget: when it runs out they count as not fitting (dropped, with the
+// reason), and the map is quantized without them, or the quantization stops for a caller that
+// parametrizes again without them.
+TEST(QuantizeSeamless, FeatureTimeBudgetDropsTheFeaturesNotTheMap) {
+  const core::TriMesh mesh = load("box.obj");
+  quantize::QuantizeOptions qo;
+  qo.feature_time_budget_seconds = 1e-9;
+  const FeatureRun run = run_with_features(mesh, 200, false, qo);
+  ASSERT_TRUE(run.param.status.is_ok()) << run.param.status.to_string();
+  ASSERT_GT(run.param.stats.n_aligned_features, 0);
+  ASSERT_TRUE(run.quantized.status.is_ok()) << run.quantized.status.to_string();
+  EXPECT_TRUE(run.quantized.stats.features_dropped);
+  EXPECT_NE(run.quantized.stats.features_dropped_reason.find("time budget"), std::string::npos)
+      << run.quantized.stats.features_dropped_reason;
+  EXPECT_EQ(test::integer_seamless_violation(run.quantized.uv), "");
+  EXPECT_EQ(run.quantized.stats.n_flipped, 0);
+  qo.target_faces = 200;
+  qo.quantize_without_features = false;
+  const quantize::QuantizeResult stopped = quantize::quantize_seamless(mesh, run.param, qo);
+  EXPECT_EQ(stopped.status.code(), core::StatusCode::kNotConverged) << stopped.status.to_string();
+  EXPECT_TRUE(stopped.stats.features_dropped);
+  qo.feature_time_budget_seconds = -1;
+  EXPECT_EQ(quantize::quantize_seamless(mesh, run.param, qo).status.code(),
+            core::StatusCode::kInvalidInput);
+}
+
 // A plate with five square holes at a coarse grid: the holes are about a quad wide, and with
 // every crease aligned some translation around a hole has no flip-free integer. Only the
 // alignment rows near that dead end are released; the rest of the creases stay on iso-lines.

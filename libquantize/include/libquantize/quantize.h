@@ -65,6 +65,12 @@ struct QuantizeOptions {
   // Wall-clock limit of the quantization in seconds (0 = none). When it is exceeded the result
   // is kNotConverged with a message naming the scale, the stage and what to try.
   double time_budget_seconds = 0;
+  // Wall-clock limit of the rounding with the aligned features in seconds (0 = none), counted
+  // from the start of the quantization: when it is exceeded the features are treated as not
+  // fitting (as a dead end: stats.features_dropped, then quantize_without_features decides).
+  // The rounding of a map whose features cannot fit can spend many minutes in collisions and
+  // releases before it dead-ends (dragon, 108K triangles: 708 s).
+  double feature_time_budget_seconds = 0;
   // Optional progress callback, once per batch: stage "quantize x<scale factor> cones" or
   // "... translations", step = integer unknowns rounded so far of n_steps independent ones.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
