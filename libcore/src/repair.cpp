@@ -1,8 +1,9 @@
 // repair_mesh: polygon soup → manifold, consistently oriented triangle mesh. Steps, in order:
 // triangulate, drop invalid faces, weld (hash grid), drop collapsed faces, remove zero-area
 // triangles by splitting their neighbour (keeps closed surfaces closed), drop duplicate faces,
-// remove fins (small flaps hanging on non-manifold edges), split non-manifold edges and vertices (one vertex copy per fan), orient components, drop
-// unreferenced vertices, check with build_edge_topology.
+// remove fins (small flaps hanging on non-manifold edges), split non-manifold edges and vertices
+// (one vertex copy per fan), orient components, drop unreferenced vertices, check with
+// build_edge_topology.
 #include <libcore/repair.h>
 
 #include <libcore/predicates.h>

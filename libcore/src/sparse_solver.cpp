@@ -44,7 +44,7 @@ struct SparseSolver::Impl {
   // The upper triangle: with a fill-reducing permutation CHOLMOD's supernodal factorization
   // makes S = tril(P·A·Pᵀ) from an upper-stored A in one transpose, from a lower-stored one in
   // two (cholmod_factorize.c); both triangles are stored, so either view is the same matrix.
-  // Measured: see the README design note on the sparse solver.
+  // Measured: README design note "Heap reuse and one transpose per factorization".
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Upper> supernodal;
 #endif
   bool use_supernodal = false;

@@ -269,12 +269,17 @@ TEST(Repair, DuplicateFaceAndInvalidFaceAndIsolatedVertices) {
   for (int v = 0; v < 8; ++v) EXPECT_EQ(r.vertex_origin[v], v);
 }
 
-TEST(Repair, NonManifoldFinIsRemoved) {
+// The unit cube with a fin on its edge (0,1): three faces on the edge.
+PolyMesh cube_with_fin() {
   PolyMesh m = cube_tris();
   m.V.conservativeResize(9, 3);
   m.V.row(8) << -1, 0.5, 0.5;
-  m.add_face({0, 1, 8});  // a fin on cube edge (0,1): three faces on the edge
-  const RepairResult r = repair_mesh(m);
+  m.add_face({0, 1, 8});
+  return m;
+}
+
+TEST(Repair, NonManifoldFinIsRemoved) {
+  const RepairResult r = repair_mesh(cube_with_fin());
   ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
   expect_closed_genus(r, 1, 0, "fin");
   EXPECT_EQ(r.report.fin_faces_removed, 1);
@@ -284,13 +289,9 @@ TEST(Repair, NonManifoldFinIsRemoved) {
 }
 
 TEST(Repair, NonManifoldFinEdgeIsDetachedWhenFinsAreKept) {
-  PolyMesh m = cube_tris();
-  m.V.conservativeResize(9, 3);
-  m.V.row(8) << -1, 0.5, 0.5;
-  m.add_face({0, 1, 8});
   RepairOptions options;
   options.max_fin_faces = 0;
-  const RepairResult r = repair_mesh(m, options);
+  const RepairResult r = repair_mesh(cube_with_fin(), options);
   ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
   const TopologyStats s = topology_stats(r.mesh);
   EXPECT_TRUE(s.is_manifold()) << s.n_nonmanifold_edges << " " << s.n_nonmanifold_vertices;

@@ -46,6 +46,7 @@ struct RemeshArgs {
 // mesh then has quads that meet themselves (not manifold). The quantization is then run again on
 // a grid with kRefineFactor times as many quads, at most kMaxRefinements times.
 constexpr int kMaxRefinements = 3;
+constexpr double kRefineFactor = 1.3;
 
 // The rounding with aligned features gets at most max(kMinFeatureSeconds, kFeatureTimeFactor ×
 // the parametrization's seconds) before the features count as not fitting and the map is
@@ -54,7 +55,6 @@ constexpr int kMaxRefinements = 3;
 // creases) dead-ended after 708 s.
 constexpr double kMinFeatureSeconds = 120;
 constexpr double kFeatureTimeFactor = 3;
-constexpr double kRefineFactor = 1.3;
 
 // The same density request kRefineFactor times finer (more quads).
 void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {

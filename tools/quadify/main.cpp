@@ -38,8 +38,8 @@ Run `quadify <command> --help` for the options of a command.)";
 // MB at 100K triangles, allocated and freed hundreds of times) are kept in the heap for reuse
 // instead of being mapped and unmapped each time by glibc's default; every fresh mapping costs
 // page faults on all its pages. feline (100K triangles, 2 cores): 0.85–1.4 M minor page faults →
-// 0.31 M, quantization 17–32 s → 15.4–15.7 s, the whole run 60–79 s → 53–54 s, peak memory
-// 1.05 → 1.27 GB. Process-wide, so set here (the libraries keep no global state).
+// 0.31 M, quantization 17–36 s → 15.4–18.7 s, the whole run 60–84 s → 54–64 s, peak memory
+// 1.05 → 1.27 GB (README: "Heap reuse and one transpose per factorization"). Process-wide, so set here (the libraries keep no global state).
 void keep_large_blocks_in_heap() {
 #ifdef __GLIBC__
   mallopt(M_MMAP_THRESHOLD, 1 << 30);
