@@ -1,5 +1,6 @@
 #include <libparam/seamless_param.h>
 
+#include "coarse_cones.h"
 #include "cone_pairs.h"
 #include "constraint_elimination.h"
 #include "cut_layout.h"
@@ -807,6 +808,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
   if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
     return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
+  if (!(o.cone_scale >= 0) || !std::isfinite(o.cone_scale))
+    return core::Status::invalid_input("cone_scale must be finite and >= 0");
   if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
   if (!(o.feature_max_tau > 1) || !(o.feature_max_wedge_stretch >= 1))
     return core::Status::invalid_input("feature_max_tau must be > 1 and feature_max_wedge_stretch >= 1");
@@ -864,6 +867,30 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   result.uv.mesh = mesh;
   result.status = validate(mesh, options);
   if (!result.status.is_ok()) return result;
+  std::string coarse_fallback;
+  if (options.cone_scale > 0 && options.feature_edges.empty() && options.face_direction.empty() &&
+      !(options.align_boundaries && core::topology_stats(mesh).n_boundary_loops > 0)) {
+    ParamOptions fine_options = options;
+    fine_options.cone_scale = 0;
+    core::TriMesh smoothed;
+    core::Status s = smooth_for_cones(mesh, options.cone_scale, &smoothed);
+    if (s.is_ok()) {
+      const ParamResult coarse = compute_seamless_param(smoothed, fine_options);
+      s = coarse.status;
+      if (s.is_ok()) {
+        result = relayout_on_mesh(mesh, coarse, options);
+        s = result.status;
+        if (s.is_ok()) {
+          result.stats.coarse_cones = true;
+          result.stats.seconds_total = seconds_since(t0);
+          return result;
+        }
+      }
+    }
+    coarse_fallback = s.message();
+    result = ParamResult{};
+    result.uv.mesh = mesh;
+  }
   core::EdgeTopology topo;
   try {
     topo = core::build_edge_topology(mesh);
@@ -1031,6 +1058,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   if (result.status.is_ok() && st.seam_residual > options.seam_tol * diag)
     result.status = core::Status::not_converged("seam residual " + std::to_string(st.seam_residual) +
                                                 " above tolerance");
+  st.coarse_cones_fallback_reason = coarse_fallback;
   st.seconds_total = seconds_since(t0);
   return result;
 }

@@ -360,5 +360,35 @@ TEST(FeatureAlignment, RejectsAPairThatIsNotAnEdge) {
   EXPECT_NE(r.status.message().find("feature edge"), std::string::npos) << r.status.message();
 }
 
+
+// Coarse cones (ParamOptions::cone_scale): the matchings rounded on a copy of spot smoothed at a
+// length of several mesh edges carry over to spot itself as a flip-free seamless map whose cones
+// satisfy Gauss–Bonnet, with fewer cones than the map of spot's own curvature; with features the
+// option is ignored (their labels belong to the original layout).
+TEST(SeamlessParam, ConeScaleGivesFewerConesAndAFlipFreeSeamlessMap) {
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("spot.obj")));
+  ParamOptions plain;
+  plain.energy = Energy::kSymmetricDirichlet;
+  const ParamResult fine = compute_seamless_param(mesh, plain);
+  check_result("spot", mesh, fine);
+  EXPECT_FALSE(fine.stats.coarse_cones);
+  ParamOptions coarse_options = plain;
+  coarse_options.cone_scale = 0.2;  // model units: spot's mean edge length is about 0.04
+  const ParamResult coarse = compute_seamless_param(mesh, coarse_options);
+  const Checked c = check_result("spot (coarse cones)", mesh, coarse);
+  EXPECT_TRUE(coarse.stats.coarse_cones) << coarse.stats.coarse_cones_fallback_reason;
+  EXPECT_EQ(c.cone_sum, 8) << "Σ cone index must be 4χ";
+  EXPECT_LT(coarse.stats.n_cones, fine.stats.n_cones);
+  // The map is of spot's own triangles: same faces, finite distortion.
+  EXPECT_EQ(coarse.uv.mesh.V, mesh.V);
+  EXPECT_TRUE(std::isfinite(coarse.stats.tau));
+  ParamOptions with_features = coarse_options;
+  with_features.feature_edges = {{mesh.F(0, 0), mesh.F(0, 1)}};
+  const ParamResult ignored = compute_seamless_param(mesh, with_features);
+  EXPECT_FALSE(ignored.stats.coarse_cones);
+  ParamOptions negative = plain;
+  negative.cone_scale = -1;
+  EXPECT_EQ(compute_seamless_param(mesh, negative).status.code(), core::StatusCode::kInvalidInput);
+}
 }  // namespace
 }  // namespace quadify::param

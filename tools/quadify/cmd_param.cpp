@@ -95,6 +95,8 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"patches", s.n_patches},
                      {"improved", s.n_improved},
                      {"cancelled_pairs", s.n_cancelled_pairs},
+                     {"coarse_cones", s.coarse_cones},
+                     {"coarse_cones_fallback_reason", s.coarse_cones_fallback_reason},
                      {"batches", s.n_batches},
                      {"iterations", s.total_iterations},
                      {"flipped", s.n_flipped},
@@ -180,6 +182,12 @@ CommandRunner register_param(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--cone-pair-hops", o.cone_pair_max_hops, "Seam edges of a cone-pair cancellation path")
       ->check(CLI::Range(1, 10))
+      ->capture_default_str();
+  app.add_option("--cone-scale", o.cone_scale,
+                 "Round the matchings on a copy of the mesh smoothed at this length (model units), so that "
+                 "curvature details smaller than it make no cones, then lay out the mesh itself under "
+                 "them; ignored with features or boundary alignment (0 = off, the paper)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   add_feature_options(app, &args->features);
   add_sizing_options(app, &args->sizing);

@@ -34,6 +34,7 @@ struct RemeshArgs {
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
+  double cone_scale = 0;          // × the target quad edge length, 0 = off
   double time_budget = 0;         // seconds for the quantization, 0 = none
   // Detected creases that are all shorter than this many target quad edges (no knife edge among
   // them) are left out: an organic model's stray fragments. 0 = always aligned.
@@ -91,6 +92,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.cone_pair_distance =
       quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
+  param_options.cone_scale = args.cone_scale * quantize::target_edge_length(mesh, quantize_options);
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &param_options);
@@ -270,6 +272,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   report["param"] = {{"cones", ps.n_cones},           {"seam_edges", ps.n_seam_edges},
                      {"patches", ps.n_patches},       {"improved", ps.n_improved},
                      {"cancelled_pairs", ps.n_cancelled_pairs},
+                     {"coarse_cones", ps.coarse_cones},
+                     {"coarse_cones_fallback_reason", ps.coarse_cones_fallback_reason},
                      {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
                      {"features", feature_json(feature_input, ps)},
                      {"sizing", sizing.report},
@@ -391,6 +395,11 @@ CommandRunner register_remesh(CLI::App& app) {
                  "shorter than this many quad edge lengths (and at least 8 mean edge lengths of the input), "
                  "by changing the matchings along the path: such pairs cannot sit on distinct grid points "
                  "and add two irregular vertices (0 = keep every cone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--cone-scale", args->cone_scale,
+                 "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
+                 "curvature details smaller than that make no cones of their own (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--min-crease-quads", args->min_crease_quads,

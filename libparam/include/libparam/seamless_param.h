@@ -62,6 +62,16 @@ struct ParamOptions {
   // points of a grid coarser than their distance. 0 = off (the paper's method).
   double cone_pair_distance = 0;
   int cone_pair_max_hops = 3;
+  // Coarse cones (not in the paper; for quad meshing at coarse densities): when > 0, the
+  // matchings are rounded (Alg. 1, with the cone-pair cancellation) on a copy of the mesh
+  // smoothed at this length (model units; one implicit cotangent-Laplacian heat step of time
+  // cone_scale²), where curvature details smaller than it do not make cones of their own, and
+  // the layout is then optimized on the mesh itself under those matchings, flip-free (symmetric
+  // Dirichlet for Energy::kTau). Ignored when features, boundary alignment or directions are
+  // asked for (their labels belong to the original layout). If the smoothed copy collapses or
+  // its map cannot be carried over flip-free, the mesh is parametrized as with 0 (the reason is
+  // in ParamStats::coarse_cones_fallback_reason). 0 = off (the paper's method).
+  double cone_scale = 0;
   // Feature alignment (paper section 6, Alg. 2): each of these mesh edges (pairs of vertex ids,
   // in either order) is made parallel to the u or the v axis of its chart, labeled together with
   // the matchings in the same batches (a label is rounded like a matching: the edge's angle to the
@@ -137,6 +147,8 @@ struct ParamStats {
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
+  bool coarse_cones = false;   // the matchings were rounded on the smoothed copy (cone_scale)
+  std::string coarse_cones_fallback_reason;  // why cone_scale was asked for but not used
   int n_feature_edges = 0;     // feature edges asked for (listed, plus boundaries if aligned)
   int n_aligned_features = 0;  // feature edges aligned in the result (see ParamResult::features)
   int n_disabled_features = 0; // feature edges whose alignment was disabled (τ bound, wedge
