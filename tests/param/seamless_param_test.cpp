@@ -360,7 +360,6 @@ TEST(FeatureAlignment, RejectsAPairThatIsNotAnEdge) {
   EXPECT_NE(r.status.message().find("feature edge"), std::string::npos) << r.status.message();
 }
 
-
 // Coarse cones (ParamOptions::cone_scale): the matchings rounded on a copy of spot smoothed at a
 // length of several mesh edges carry over to spot itself as a flip-free seamless map whose cones
 // satisfy Gauss–Bonnet, with fewer cones than the map of spot's own curvature; with features the
@@ -390,5 +389,6 @@ TEST(SeamlessParam, ConeScaleGivesFewerConesAndAFlipFreeSeamlessMap) {
   negative.cone_scale = -1;
   EXPECT_EQ(compute_seamless_param(mesh, negative).status.code(), core::StatusCode::kInvalidInput);
 }
+
 }  // namespace
 }  // namespace quadify::param

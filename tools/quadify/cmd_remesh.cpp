@@ -399,7 +399,7 @@ CommandRunner register_remesh(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--cone-scale", args->cone_scale,
                  "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
-                 "curvature details smaller than that make no cones of their own (0 = off)")
+                 "curvature details smaller than that make no cones of their own; ignored while features are aligned (0 = off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--min-crease-quads", args->min_crease_quads,
