@@ -41,6 +41,7 @@
 //    and the transitions and cones are exact integers. This is verified (kInternal otherwise), and
 //    flips are counted with the exact orientation predicate.
 #include <libcore/predicates.h>
+#include <libcore/topology.h>
 #include <libparam/constrained_layout.h>
 #include <libquantize/quantize.h>
 
@@ -1077,6 +1078,17 @@ double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeO
       sum += (mesh.V.row(mesh.F(f, k)) - mesh.V.row(mesh.F(f, (k + 1) % 3))).norm();
   const double mean_edge = sum / (3.0 * mesh.n_faces());
   return std::max(quad_edges * target_edge_length(mesh, options), kConePairMeshEdges * mean_edge);
+}
+
+double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& options, int n_cones) {
+  if (mesh.n_faces() == 0) return 0;
+  const double h = target_edge_length(mesh, options);
+  const double target_quads = surface_area(mesh) / (h * h);
+  // Cones beyond what the topology asks for: a closed surface of Euler characteristic χ needs
+  // at least 4|χ| of them (eight on a sphere), which no smoothing removes.
+  const core::TopologyStats topo = core::topology_stats(mesh);
+  const int needed = topo.n_boundary_loops == 0 ? 4 * std::abs(topo.euler_characteristic) : 0;
+  return (n_cones - needed) * kQuadsPerCone > target_quads ? kCoarseConeQuadEdges * h : 0;
 }
 
 namespace {

@@ -253,6 +253,25 @@ TEST(QuantizeCurves, LongestCurveInQuadEdgesAndKnifeEdges) {
   EXPECT_FALSE(none.has_knife_edge);
 }
 
+TEST(QuantizeCoarseCones, OnlyConesBeyondTheTopologysNeedCount) {
+  // sphere.obj (closed, χ = 2) needs 8 cones: at 100 target quads, 8 + 2 cones (2 × 40 ≤ 100) keep
+  // the map; 8 + 3 ask for coarse cones at 1.4 quad edges. The open disk needs none.
+  const core::TriMesh sphere = core::to_trimesh(core::read_mesh(test::data_path("sphere.obj")));
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 100;
+  const double h = quantize::target_edge_length(sphere, qo);
+  EXPECT_EQ(quantize::recommended_cone_scale(sphere, qo, 8), 0);
+  EXPECT_EQ(quantize::recommended_cone_scale(sphere, qo, 10), 0);
+  EXPECT_NEAR(quantize::recommended_cone_scale(sphere, qo, 11), quantize::kCoarseConeQuadEdges * h, 1e-12 * h);
+  qo.target_faces = 1000;
+  EXPECT_EQ(quantize::recommended_cone_scale(sphere, qo, 11), 0);
+  const core::TriMesh disk = core::to_trimesh(core::read_mesh(test::data_path("disk.obj")));
+  quantize::QuantizeOptions dq;
+  dq.target_faces = 80;
+  EXPECT_EQ(quantize::recommended_cone_scale(disk, dq, 2), 0);
+  EXPECT_GT(quantize::recommended_cone_scale(disk, dq, 3), 0);
+}
+
 TEST(QuantizeSeamless, RejectsNonSeamlessInput) {
   const core::TriMesh mesh = load("sphere.obj");
   param::ParamResult p = param::compute_seamless_param(mesh);

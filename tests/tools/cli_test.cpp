@@ -292,6 +292,65 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   EXPECT_LT(j["hausdorff_sym"].get<double>(), 0.02);
 }
 
+// At 800 quads spot's map has 44 cones (36 more than a sphere needs, one per 22 quads): by default
+// the matchings are rounded on a smoothed copy, which leaves fewer cones and still a valid mesh;
+// --cone-scale 0 keeps the paper's map.
+TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
+  const std::string spot = data_path("spot.obj").string();
+  auto run = [&](const std::string& extra) {
+    std::string args;
+    args.append("'").append(spot).append("' -o '").append((dir_ / "o.obj").string());
+    args.append("' --target-faces 800 --samples 20000 --json '").append((dir_ / "r.json").string());
+    args.append("' ").append(extra);
+    const CliRun r = quadify(args, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(slurp(dir_ / "r.json"));
+  };
+  const auto coarse = run("");
+  EXPECT_EQ(coarse["param"]["coarse_cones"], true) << coarse["param"].dump();
+  ASSERT_TRUE(coarse["param"]["fine_cones"].is_number()) << coarse["param"].dump();
+  const int fine_cones = coarse["param"]["fine_cones"];
+  EXPECT_LT(coarse["param"]["cones"].get<int>(), fine_cones);
+  const auto q = coarse["quads"];
+  EXPECT_EQ(q["non_quads"], 0);
+  EXPECT_EQ(q["manifold"], true);
+  EXPECT_EQ(q["flipped_quads"], 0);
+  EXPECT_EQ(q["genus"], 0);
+  EXPECT_LT(q["irregular_vertices"].get<int>(), fine_cones);
+  EXPECT_NEAR(q["faces"].get<int>(), 800, 80);
+  EXPECT_LT(q["hausdorff_sym"].get<double>(), 0.02);
+  const auto plain = run("--cone-scale 0");
+  EXPECT_EQ(plain["param"]["coarse_cones"], false);
+  EXPECT_TRUE(plain["param"]["fine_cones"].is_null());
+  EXPECT_EQ(plain["param"]["cones"], fine_cones);
+  std::string bad_args;
+  bad_args.append("'").append(spot).append("' -o o.obj --cone-scale sometimes");
+  const CliRun bad = quadify(bad_args, dir_);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+}
+
+// A run that fails after the input was read writes no mesh, but its report says what failed and
+// has the figures of the stages that ran.
+TEST_F(CliTest, FailedRemeshStillWritesTheReport) {
+  const fs::path out = dir_ / "o.obj";
+  const std::string spot = data_path("spot.obj").string();
+  std::string args;
+  args.append("'").append(spot).append("' -o '").append(out.string());
+  args.append("' --cone-scale 0 --time-budget 0.001 --json '").append((dir_ / "r.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("spot.obj"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  ASSERT_TRUE(fs::exists(dir_ / "r.json"));
+  const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(report["status"], "error");
+  EXPECT_NE(report["error"].get<std::string>().find("time budget"), std::string::npos) << report["error"];
+  EXPECT_FALSE(report.contains("output"));
+  EXPECT_GT(report["param"]["cones"].get<int>(), 0);
+  EXPECT_GT(report["quantize"]["integer_dofs"].get<int>(), 0);
+  EXPECT_FALSE(report.contains("quads"));
+}
+
 // The box's creases are detected at the default 40° and end up as quad edges; the report says so.
 TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   const fs::path out = dir_ / "box_quads.obj";

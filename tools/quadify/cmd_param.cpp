@@ -95,6 +95,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"patches", s.n_patches},
                      {"improved", s.n_improved},
                      {"cancelled_pairs", s.n_cancelled_pairs},
+                     {"deferred_matchings", s.n_deferred_matchings},
                      {"coarse_cones", s.coarse_cones},
                      {"coarse_cones_fallback_reason", s.coarse_cones_fallback_reason},
                      {"batches", s.n_batches},

@@ -34,7 +34,7 @@ struct RemeshArgs {
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
-  double cone_scale = 0;          // × the target quad edge length, 0 = off
+  double cone_scale = -1;         // × the target quad edge length, 0 = off, < 0 = auto
   double time_budget = 0;         // seconds for the quantization, 0 = none
   // Detected creases that are all shorter than this many target quad edges (no knife edge among
   // them) are left out: an organic model's stray fragments. 0 = always aligned.
@@ -69,10 +69,38 @@ void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* option
 }
 
 
+int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMesh& loaded, Progress& progress,
+                  nlohmann::json* report_out);
+
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   core::check_can_write(args.output);
   Progress progress(common.quiet);
   LoadedMesh loaded = load_and_repair(args.input, progress);
+  const core::TriMesh& mesh = loaded.repaired.mesh;
+  nlohmann::json report;
+  report["command"] = "remesh";
+  report["status"] = "ok";
+  report["input"] = input_json(args.input, loaded.raw);
+  report["repair"] = to_json(loaded.repaired.report);
+  report["mesh"] = to_json(core::topology_stats(mesh));
+  report["output"] = args.output;
+  // A failure after this point still writes the report (status "error", the message, and the
+  // figures of the stages that ran), but no mesh.
+  try {
+    return remesh_stages(args, common, loaded, progress, &report);
+  } catch (const CliError& e) {
+    report["status"] = "error";
+    report["error"] = e.message;
+    report.erase("output");
+    report["timings"] = progress.timings();
+    write_report(common, report);
+    throw;
+  }
+}
+
+int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMesh& loaded, Progress& progress,
+                  nlohmann::json* report_out) {
+  nlohmann::json& report = *report_out;
   const core::TriMesh& mesh = loaded.repaired.mesh;
   auto on_progress = [&progress](const std::string& stage, int step, int n_steps) {
     progress.step(stage + " " + std::to_string(step) + "/" + std::to_string(n_steps));
@@ -92,7 +120,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   param_options.cone_pair_distance =
       quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
-  param_options.cone_scale = args.cone_scale * quantize::target_edge_length(mesh, quantize_options);
+  param_options.cone_scale = std::max(0.0, args.cone_scale) * quantize::target_edge_length(mesh, quantize_options);
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &param_options);
@@ -138,11 +166,55 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     param_options.feature_edges = quantize::features_for_density(mesh, param_options.feature_edges, quantize_options);
     feature_input.n_too_small = static_cast<int>(before - param_options.feature_edges.size());
   }
+  // The report's param and quantize sections, written as soon as a stage has run.
+  int fine_cones = -1;  // the feature-free map's cones, when coarse cones replaced it
+  std::string coarse_reason;
+  bool features_dropped = false;
+  std::string features_dropped_reason;
+  int refinements = 0;
+  auto param_json = [&](const param::ParamResult& map) {
+    const param::ParamStats& ps = map.stats;
+    return nlohmann::json{{"cones", ps.n_cones},           {"seam_edges", ps.n_seam_edges},
+                       {"patches", ps.n_patches},       {"improved", ps.n_improved},
+                       {"cancelled_pairs", ps.n_cancelled_pairs},
+                       {"deferred_matchings", ps.n_deferred_matchings},
+                       {"coarse_cones", ps.coarse_cones},
+                       {"coarse_cones_fallback_reason",
+                        coarse_reason.empty() ? ps.coarse_cones_fallback_reason : coarse_reason},
+                       {"fine_cones", fine_cones >= 0 ? nlohmann::json(fine_cones) : nlohmann::json()},
+                       {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
+                       {"features", feature_json(feature_input, ps)},
+                       {"sizing", sizing.report},
+                       {"curvature_alignment", direction_json(sizing, ps)},
+                       {"seconds", ps.seconds_total}};
+  };
+  auto quantize_json = [&](const quantize::QuantizeResult& map) {
+    const quantize::QuantizeStats& qs = map.stats;
+    return nlohmann::json{{"scale", qs.scale},          {"target_faces", args.target_faces},
+                          {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
+                          {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
+                          {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
+                          {"aligned_features", qs.n_aligned_features},
+                          {"released_feature_lines", qs.n_released_feature_lines},
+                          {"released_feature_edges", qs.n_released_feature_edges},
+                          {"refinements", refinements},
+                          {"features_dropped", features_dropped || qs.features_dropped},
+                          {"features_dropped_reason", features_dropped ? features_dropped_reason
+                                                                       : qs.features_dropped_reason},
+                          {"clustered_cones", qs.n_clustered_cones},
+                          {"cone_collisions", qs.n_cone_collisions},
+                          {"newton_iterations", qs.n_iterations},
+                          {"seconds_setup", qs.seconds_setup},
+                          {"seconds_rounding", qs.seconds_rounding},
+                          {"seconds_final", qs.seconds_final},
+                          {"seconds", qs.seconds}};
+  };
   auto parametrize = [&](const param::ParamOptions& options) {
     progress.begin("param");
     param::ParamResult result = param::compute_seamless_param(mesh, options);
     progress.end();
     warn_feature_fallbacks(args.input, result.stats, common.quiet);
+    report["param"] = param_json(result);
     if (result.status.code() == core::StatusCode::kInvalidInput)
       throw CliError{kExitBadInput, args.input + ": " + result.status.message()};
     if (!result.status.is_ok())
@@ -153,16 +225,47 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     progress.begin("quantize");
     quantize::QuantizeResult result = quantize::quantize_seamless(mesh, map, quantize_options);
     progress.end();
+    report["quantize"] = quantize_json(result);
     return result;
   };
   param::ParamResult seamless = parametrize(param_options);
+  // Coarse cones by default: a feature-free map with more cones than the grid has room for (they
+  // follow the tessellation's curvature, not the target density) is parametrized again with its
+  // matchings rounded on a smoothed copy; if that fails, the map stays as it is.
+  auto coarsen = [&]() {
+    if (args.cone_scale >= 0 || !param_options.feature_edges.empty() || !param_options.face_direction.empty())
+      return;
+    param::ParamOptions coarse_options = param_options;
+    coarse_options.cone_scale = quantize::recommended_cone_scale(mesh, quantize_options, seamless.stats.n_cones);
+    if (!(coarse_options.cone_scale > 0)) return;
+    coarse_options.cone_scale_fallback = false;
+    if (!common.quiet)
+      std::fprintf(stderr,
+                   "quadify: %s: %d cones, more than one per %.0f target quads beyond what the topology "
+                   "needs: rounding the matchings on a copy smoothed at %.2g quad edges (--cone-scale 0 "
+                   "keeps them)\n",
+                   args.input.c_str(), seamless.stats.n_cones, quantize::kQuadsPerCone,
+                   quantize::kCoarseConeQuadEdges);
+    progress.begin("param");
+    param::ParamResult coarse = param::compute_seamless_param(mesh, coarse_options);
+    progress.end();
+    if (coarse.status.is_ok()) {
+      fine_cones = seamless.stats.n_cones;
+      seamless = std::move(coarse);
+      report["param"] = param_json(seamless);
+    } else {
+      coarse_reason = coarse.stats.coarse_cones_fallback_reason;
+      if (!common.quiet)
+        std::fprintf(stderr, "quadify: %s: coarse cones not used (%s); keeping the %d cones\n",
+                     args.input.c_str(), coarse_reason.c_str(), seamless.stats.n_cones);
+    }
+  };
+  coarsen();
   quantize_options.feature_time_budget_seconds =
       std::max(kMinFeatureSeconds, kFeatureTimeFactor * seamless.stats.seconds_total);
   quantize::QuantizeResult integer_map = quantize_map(seamless);
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
-  bool features_dropped = false;
-  std::string features_dropped_reason;
   if (integer_map.stats.features_dropped &&
       (integer_map.status.is_ok() || integer_map.status.code() == core::StatusCode::kNotConverged)) {
     features_dropped = true;
@@ -178,6 +281,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
     param_options.feature_edges.clear();
     param_options.align_boundaries = false;
     seamless = parametrize(param_options);
+    coarsen();
     integer_map = quantize_map(seamless);
   }
   if (integer_map.status.is_ok() && integer_map.stats.n_released_feature_edges > 0 && !common.quiet)
@@ -203,7 +307,6 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   quadex::ExtractResult extracted = extract(integer_map);
   if (!extracted.status.is_ok())
     throw CliError{kExitInternal, args.input + ": quad extraction failed: " + extracted.status.to_string()};
-  int refinements = 0;
   // Only an input that was manifold before the repair must give manifold quads (the places
   // where the repair split a non-manifold edge or vertex are kept as they are).
   const bool manifold_input = loaded.repaired.report.nonmanifold_edges_split == 0 &&
@@ -261,43 +364,8 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   core::write_mesh(args.output, extracted.quads);
   progress.end();
 
-  nlohmann::json report;
-  report["command"] = "remesh";
-  report["status"] = "ok";
-  report["input"] = input_json(args.input, loaded.raw);
-  report["repair"] = to_json(loaded.repaired.report);
-  report["mesh"] = to_json(core::topology_stats(mesh));
-  report["output"] = args.output;
-  const param::ParamStats& ps = seamless.stats;
-  report["param"] = {{"cones", ps.n_cones},           {"seam_edges", ps.n_seam_edges},
-                     {"patches", ps.n_patches},       {"improved", ps.n_improved},
-                     {"cancelled_pairs", ps.n_cancelled_pairs},
-                     {"coarse_cones", ps.coarse_cones},
-                     {"coarse_cones_fallback_reason", ps.coarse_cones_fallback_reason},
-                     {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
-                     {"features", feature_json(feature_input, ps)},
-                     {"sizing", sizing.report},
-                     {"curvature_alignment", direction_json(sizing, ps)},
-                     {"seconds", ps.seconds_total}};
-  const quantize::QuantizeStats& qs = integer_map.stats;
-  report["quantize"] = {{"scale", qs.scale},          {"target_faces", args.target_faces},
-                        {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
-                        {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
-                        {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
-                        {"aligned_features", qs.n_aligned_features},
-                        {"released_feature_lines", qs.n_released_feature_lines},
-                        {"released_feature_edges", qs.n_released_feature_edges},
-                        {"refinements", refinements},
-                        {"features_dropped", features_dropped || qs.features_dropped},
-                        {"features_dropped_reason", features_dropped ? features_dropped_reason
-                                                                     : qs.features_dropped_reason},
-                        {"clustered_cones", qs.n_clustered_cones},
-                        {"cone_collisions", qs.n_cone_collisions},
-                        {"newton_iterations", qs.n_iterations},
-                        {"seconds_setup", qs.seconds_setup},
-                        {"seconds_rounding", qs.seconds_rounding},
-                        {"seconds_final", qs.seconds_final},
-                        {"seconds", qs.seconds}};
+  report["param"] = param_json(seamless);
+  report["quantize"] = quantize_json(integer_map);
   const quadex::ExtractStats& es = extracted.stats;
   report["extract"] = {{"vertices", es.n_vertices}, {"faces", es.n_faces}, {"non_quads", es.n_non_quads},
                        {"boundary_crossings", es.n_boundary_crossings}, {"seconds", es.seconds}};
@@ -397,11 +465,20 @@ CommandRunner register_remesh(CLI::App& app) {
                  "and add two irregular vertices (0 = keep every cone)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--cone-scale", args->cone_scale,
-                 "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
-                 "curvature details smaller than that make no cones of their own; ignored while features are aligned (0 = off)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--cone-scale",
+         [args](const std::string& text) { args->cone_scale = text == "auto" ? -1 : std::stod(text); },
+         "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
+         "curvature details smaller than that make no cones of their own; ignored while features are "
+         "aligned. 0 = off; auto (the default): 1.4 when the feature-free map has more than one cone "
+         "per 40 target quads beyond the 4|Euler characteristic| a closed surface needs (its cone "
+         "count is then param.fine_cones in the report), else off")
+      ->check([](const std::string& text) {
+        if (text == "auto") return std::string();
+        return CLI::NonNegativeNumber(text);
+      })
+      ->default_str("auto")
+      ->type_name("Q|auto");
   app.add_option("--min-crease-quads", args->min_crease_quads,
                  "Leave the detected creases unaligned when every crease curve is shorter than this "
                  "many quad edges and none is a knife edge (median dihedral angle of at least 120 "

@@ -72,6 +72,9 @@ struct ParamOptions {
   // its map cannot be carried over flip-free, the mesh is parametrized as with 0 (the reason is
   // in ParamStats::coarse_cones_fallback_reason). 0 = off (the paper's method).
   double cone_scale = 0;
+  // With cone_scale > 0: whether a coarse path that cannot be used falls back to the paper's map
+  // (true), or returns its failure status (false; for a caller that already holds that map).
+  bool cone_scale_fallback = true;
   // Feature alignment (paper section 6, Alg. 2): each of these mesh edges (pairs of vertex ids,
   // in either order) is made parallel to the u or the v axis of its chart, labeled together with
   // the matchings in the same batches (a label is rounded like a matching: the edge's angle to the
@@ -147,6 +150,7 @@ struct ParamStats {
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
+  int n_deferred_matchings = 0;  // seams whose rounding a batch deferred (flips near them)
   bool coarse_cones = false;   // the matchings were rounded on the smoothed copy (cone_scale)
   std::string coarse_cones_fallback_reason;  // why cone_scale was asked for but not used
   int n_feature_edges = 0;     // feature edges asked for (listed, plus boundaries if aligned)

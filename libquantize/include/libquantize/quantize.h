@@ -130,6 +130,18 @@ struct QuantizeResult {
                                                     double quad_edges = 4);
 inline constexpr int kRecommendedConePairHops = 6;
 
+// The param::ParamOptions::cone_scale that suits quantization at `options`' density, for a
+// feature-free map with n_cones cones: 0 (the paper's map as it is) while the cones beyond the
+// 4|χ| a closed surface needs are at most one per kQuadsPerCone target quads, else
+// kCoarseConeQuadEdges target quad edge lengths
+// (the matchings rounded on a smoothed copy). Measured at 5,000 quads: maps with one cone per
+// 28 quads or more (mannequin-devil 177, dragon about 380) dead-end in the rounding, where the
+// coarse map rounds in seconds; the bench meshes that quantize have one per 54 or fewer.
+inline constexpr double kQuadsPerCone = 40;
+inline constexpr double kCoarseConeQuadEdges = 1.4;
+[[nodiscard]] double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& options,
+                                            int n_cones);
+
 // The feature edges (vertex-id pairs of `mesh`) that quantization at `options`' density can keep
 // on integer iso-lines: a feature curve (a connected component of the feature edges) shorter
 // than min_quad_edges target quad edges, or a closed one shorter than four times that, is dropped
