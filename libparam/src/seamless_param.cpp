@@ -924,6 +924,14 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     if (s.is_ok()) {
       const ParamResult coarse = compute_seamless_param(smoothed, fine_options);
       s = coarse.status;
+      // A cone of index 3 or more (UV angle π/2 or less: the tip of a thin part that the
+      // smoothing sharpened into a needle) would be a quad vertex of valence 1 or less, which no
+      // quad mesh has (mannequin-devil's horn tips smoothed at 1 quad edge: index 3).
+      for (const ConeInfo& c : coarse.cones)
+        if (s.is_ok() && c.index >= 3)
+          s = core::Status::not_converged("the smoothed copy has a cone of index " + std::to_string(c.index) +
+                                          " at vertex " + std::to_string(c.vertex) +
+                                          " (a quad vertex of valence " + std::to_string(4 - c.index) + ")");
       if (s.is_ok()) {
         result = relayout_on_mesh(mesh, coarse, options);
         s = result.status;

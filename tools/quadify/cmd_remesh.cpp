@@ -55,6 +55,9 @@ constexpr double kRefineFactor = 1.3;
 // after a 12 s parametrization; at 20,000 quads 20 s in all); dragon's (108K triangles, scanned
 // creases) dead-ended after 708 s.
 constexpr double kMinFeatureSeconds = 120;
+// Automatic coarse cones (--cone-scale auto) that fail at quantize::kCoarseConeQuadEdges (e.g. a
+// cone of index 3 at a thin tip) are tried once more at this many times the smoothing length.
+constexpr double kCoarseRetryFactor = 1.4;
 constexpr double kFeatureTimeFactor = 3;
 
 // The same density request kRefineFactor times finer (more quads).
@@ -235,10 +238,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   auto coarsen = [&]() {
     if (args.cone_scale >= 0 || !param_options.feature_edges.empty() || !param_options.face_direction.empty())
       return;
-    param::ParamOptions coarse_options = param_options;
-    coarse_options.cone_scale = quantize::recommended_cone_scale(mesh, quantize_options, seamless.stats.n_cones);
-    if (!(coarse_options.cone_scale > 0)) return;
-    coarse_options.cone_scale_fallback = false;
+    const double scale = quantize::recommended_cone_scale(mesh, quantize_options, seamless.stats.n_cones);
+    if (!(scale > 0)) return;
     if (!common.quiet)
       std::fprintf(stderr,
                    "quadify: %s: %d cones, more than one per %.0f target quads beyond what the topology "
@@ -246,18 +247,26 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                    "keeps them)\n",
                    args.input.c_str(), seamless.stats.n_cones, quantize::kQuadsPerCone,
                    quantize::kCoarseConeQuadEdges);
-    progress.begin("param");
-    param::ParamResult coarse = param::compute_seamless_param(mesh, coarse_options);
-    progress.end();
-    if (coarse.status.is_ok()) {
-      fine_cones = seamless.stats.n_cones;
-      seamless = std::move(coarse);
-      report["param"] = param_json(seamless);
-    } else {
+    // If that copy's map cannot be used, once more on a copy smoothed kCoarseRetryFactor more.
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      param::ParamOptions coarse_options = param_options;
+      coarse_options.cone_scale = attempt == 0 ? scale : kCoarseRetryFactor * scale;
+      coarse_options.cone_scale_fallback = false;
+      progress.begin("param");
+      param::ParamResult coarse = param::compute_seamless_param(mesh, coarse_options);
+      progress.end();
+      if (coarse.status.is_ok()) {
+        fine_cones = seamless.stats.n_cones;
+        seamless = std::move(coarse);
+        report["param"] = param_json(seamless);
+        return;
+      }
       coarse_reason = coarse.stats.coarse_cones_fallback_reason;
       if (!common.quiet)
-        std::fprintf(stderr, "quadify: %s: coarse cones not used (%s); keeping the %d cones\n",
-                     args.input.c_str(), coarse_reason.c_str(), seamless.stats.n_cones);
+        std::fprintf(stderr, "quadify: %s: coarse cones at %.2g quad edges not used (%s)%s\n", args.input.c_str(),
+                     coarse_options.cone_scale / quantize::target_edge_length(mesh, quantize_options),
+                     coarse_reason.c_str(),
+                     attempt == 0 ? "; trying a smoother copy" : "; keeping the map's cones");
     }
   };
   coarsen();
