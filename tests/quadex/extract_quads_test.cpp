@@ -453,6 +453,28 @@ TEST(ExtractQuads, OpenDiskConesHaveValenceThreeAndFive) {
   }
 }
 
+// A hat of four triangles around an apex whose UV fan spans one quadrant, [0,2]², closed by a
+// 90° rotation: a cone of index 3, which would be a quad vertex of valence 1. Refused with a
+// message naming it (it used to fail later, in the tracing, as an internal error).
+TEST(ExtractQuads, ConeOfIndexThreeIsRejected) {
+  UVMesh hat;
+  hat.mesh.V.resize(5, 3);
+  hat.mesh.V << 0, 0, 1, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
+  hat.mesh.F.resize(4, 3);
+  hat.mesh.F << 0, 1, 2, 0, 2, 3, 0, 3, 4, 0, 4, 1;
+  const Eigen::Vector2d ring[5] = {{2, 0}, {2, 1}, {2, 2}, {1, 2}, {0, 2}};
+  hat.corner_uv.resize(12, 2);
+  for (int f = 0; f < 4; ++f) {
+    hat.corner_uv.row(3 * f) = Eigen::Vector2d(0, 0).transpose();
+    hat.corner_uv.row(3 * f + 1) = ring[f].transpose();
+    hat.corner_uv.row(3 * f + 2) = ring[f + 1].transpose();
+  }
+  const ExtractResult r = extract_quads(hat);
+  EXPECT_EQ(r.status.code(), core::StatusCode::kInvalidInput) << r.status.to_string();
+  EXPECT_NE(r.status.message().find("cone vertex 0 has index 3"), std::string::npos) << r.status.message();
+  EXPECT_NE(r.status.message().find("valence 1"), std::string::npos) << r.status.message();
+}
+
 TEST(ExtractQuads, BoundaryCrossingIsoLinesMakeBoundaryVertices) {
   // [0,4]² with UV = (x + 0.5, y + 0.3): the boundary cuts cells. Lines u = 1..4 and v = 1..4
   // give 5×5 cells: 9 interior unit quads, 12 cut quads along the sides, 4 corner triangles.
