@@ -956,7 +956,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       // The features' own budget: they count as not fitting; the attempts without them follow.
       char msg[256];
       std::snprintf(msg, sizeof msg,
-                    "the rounding with the aligned features exceeded its time budget of %.0f s "
+                    "the rounding with the aligned features exceeded its time budget of %.3g s "
                     "(%d of %d integer unknowns rounded)",
                     options.feature_time_budget_seconds, rounder.n_pinned(), rounder.n_integer_columns());
       last_stuck = msg;
@@ -967,7 +967,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     if (outcome == Rounder::Outcome::kOutOfTime) {
       char msg[512];
       std::snprintf(msg, sizeof msg,
-                    "quantization exceeded its time budget of %.0f s while rounding at scale "
+                    "quantization exceeded its time budget of %.3g s while rounding at scale "
                     "x%.3f of the target (attempt %d of %zu, %d of %d integer unknowns rounded); "
                     "a larger --time-budget, a larger --target-faces (fewer cone collisions) or "
                     "a larger --cone-pair-distance may help",

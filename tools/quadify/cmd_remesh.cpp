@@ -55,10 +55,11 @@ constexpr double kRefineFactor = 1.3;
 // after a 12 s parametrization; at 20,000 quads 20 s in all); dragon's (108K triangles, scanned
 // creases) dead-ended after 708 s.
 constexpr double kMinFeatureSeconds = 120;
+constexpr double kFeatureTimeFactor = 3;
+
 // Automatic coarse cones (--cone-scale auto) that fail at quantize::kCoarseConeQuadEdges (e.g. a
 // cone of index 3 at a thin tip) are tried once more at this many times the smoothing length.
 constexpr double kCoarseRetryFactor = 1.4;
-constexpr double kFeatureTimeFactor = 3;
 
 // The same density request kRefineFactor times finer (more quads).
 void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {
@@ -177,40 +178,47 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   int refinements = 0;
   auto param_json = [&](const param::ParamResult& map) {
     const param::ParamStats& ps = map.stats;
-    return nlohmann::json{{"cones", ps.n_cones},           {"seam_edges", ps.n_seam_edges},
-                       {"patches", ps.n_patches},       {"improved", ps.n_improved},
-                       {"cancelled_pairs", ps.n_cancelled_pairs},
-                       {"deferred_matchings", ps.n_deferred_matchings},
-                       {"coarse_cones", ps.coarse_cones},
-                       {"coarse_cones_fallback_reason",
-                        coarse_reason.empty() ? ps.coarse_cones_fallback_reason : coarse_reason},
-                       {"fine_cones", fine_cones >= 0 ? nlohmann::json(fine_cones) : nlohmann::json()},
-                       {"tau", number(ps.tau)},         {"flipped", ps.n_flipped},
-                       {"features", feature_json(feature_input, ps)},
-                       {"sizing", sizing.report},
-                       {"curvature_alignment", direction_json(sizing, ps)},
-                       {"seconds", ps.seconds_total}};
+    return nlohmann::json{
+        {"cones", ps.n_cones},
+        {"seam_edges", ps.n_seam_edges},
+        {"patches", ps.n_patches},
+        {"improved", ps.n_improved},
+        {"cancelled_pairs", ps.n_cancelled_pairs},
+        {"deferred_matchings", ps.n_deferred_matchings},
+        {"coarse_cones", ps.coarse_cones},
+        {"coarse_cones_fallback_reason", coarse_reason.empty() ? ps.coarse_cones_fallback_reason : coarse_reason},
+        {"fine_cones", fine_cones >= 0 ? nlohmann::json(fine_cones) : nlohmann::json()},
+        {"tau", number(ps.tau)},
+        {"flipped", ps.n_flipped},
+        {"features", feature_json(feature_input, ps)},
+        {"sizing", sizing.report},
+        {"curvature_alignment", direction_json(sizing, ps)},
+        {"seconds", ps.seconds_total}};
   };
   auto quantize_json = [&](const quantize::QuantizeResult& map) {
     const quantize::QuantizeStats& qs = map.stats;
-    return nlohmann::json{{"scale", qs.scale},          {"target_faces", args.target_faces},
-                          {"uv_area", qs.uv_area},      {"integer_dofs", qs.n_integer_dofs},
-                          {"reverted", qs.n_reverted},  {"scale_retries", qs.n_scale_retries},
-                          {"flipped", qs.n_flipped},    {"cones", qs.n_cones},
-                          {"aligned_features", qs.n_aligned_features},
-                          {"released_feature_lines", qs.n_released_feature_lines},
-                          {"released_feature_edges", qs.n_released_feature_edges},
-                          {"refinements", refinements},
-                          {"features_dropped", features_dropped || qs.features_dropped},
-                          {"features_dropped_reason", features_dropped ? features_dropped_reason
-                                                                       : qs.features_dropped_reason},
-                          {"clustered_cones", qs.n_clustered_cones},
-                          {"cone_collisions", qs.n_cone_collisions},
-                          {"newton_iterations", qs.n_iterations},
-                          {"seconds_setup", qs.seconds_setup},
-                          {"seconds_rounding", qs.seconds_rounding},
-                          {"seconds_final", qs.seconds_final},
-                          {"seconds", qs.seconds}};
+    return nlohmann::json{
+        {"scale", qs.scale},
+        {"target_faces", args.target_faces},
+        {"uv_area", qs.uv_area},
+        {"integer_dofs", qs.n_integer_dofs},
+        {"reverted", qs.n_reverted},
+        {"scale_retries", qs.n_scale_retries},
+        {"flipped", qs.n_flipped},
+        {"cones", qs.n_cones},
+        {"aligned_features", qs.n_aligned_features},
+        {"released_feature_lines", qs.n_released_feature_lines},
+        {"released_feature_edges", qs.n_released_feature_edges},
+        {"refinements", refinements},
+        {"features_dropped", features_dropped || qs.features_dropped},
+        {"features_dropped_reason", features_dropped ? features_dropped_reason : qs.features_dropped_reason},
+        {"clustered_cones", qs.n_clustered_cones},
+        {"cone_collisions", qs.n_cone_collisions},
+        {"newton_iterations", qs.n_iterations},
+        {"seconds_setup", qs.seconds_setup},
+        {"seconds_rounding", qs.seconds_rounding},
+        {"seconds_final", qs.seconds_final},
+        {"seconds", qs.seconds}};
   };
   auto parametrize = [&](const param::ParamOptions& options) {
     progress.begin("param");
