@@ -5,6 +5,8 @@
 #include <libcore/uv_metrics.h>
 #include <libparam/constrained_layout.h>
 
+#include "distortion_energy.h"
+
 #include <Eigen/Geometry>
 #include <Eigen/SparseCore>
 
@@ -111,6 +113,8 @@ ParamResult relayout_on_mesh(const core::TriMesh& mesh, const ParamResult& seaml
   lo.face_metric = options.face_metric;
   lo.max_newton_iters = kRelayoutNewtonIters;
   lo.relative_tolerance = kRelayoutTolerance;
+  // τ's L^p continuation after the symmetric Dirichlet solve (as in compute_seamless_param).
+  if (options.energy == Energy::kTau) lo.tau_powers.assign(std::begin(kTauPowers), std::end(kTauPowers));
   const ConstrainedLayoutResult r = solve_constrained_layout(mesh, copies, copies.x, {}, {}, lo);
   out.stats.total_iterations += r.iterations;
   if (!r.status.is_ok()) {

@@ -339,6 +339,23 @@ ConstrainedLayoutResult solve_constrained_layout(const core::TriMesh& mesh,
       const Eigen::VectorXd xn = red.expand(y);
       if (count_flipped(domain, xn) == 0) x = xn;
     }
+    if (!options.tau_powers.empty()) {
+      LayoutProblem problem(domain, red);
+      for (const double p : options.tau_powers) {
+        OptimizeSettings ts;
+        ts.density = Density::kPowerSD;
+        ts.power = p;
+        ts.max_iterations = kTauStageIterations;
+        ts.relative_tolerance = kTauStageTolerance;
+        Eigen::VectorXd yt = red.restrict(x);
+        const OptimizeReport tr = optimize_layout(problem, ts, &yt);
+        res.iterations += tr.iterations;
+        if (!tr.status.is_ok() || !std::isfinite(tr.energy)) break;
+        const Eigen::VectorXd xn = red.expand(yt);
+        if (count_flipped(domain, xn) != 0) break;
+        x = xn;
+      }
+    }
     res.n_flipped = count_flipped(domain, x);
   }
   if (res.status.is_ok() && res.n_flipped > 0)

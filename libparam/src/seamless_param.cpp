@@ -45,16 +45,6 @@ double seconds_since(Clock::time_point t0) {
 // steer the next matchings, the final layouts are converged further.
 constexpr double kBatchTolerance = 1e-5;
 constexpr double kFinalTolerance = 1e-8;
-// Exponents of the L^p continuation of the symmetric Dirichlet energy for Energy::kTau. Going on
-// to 64 after 16 lowered τ by 5–10% (spot 1.525 → 1.405, casting 1.536 → 1.466, elk 1.564 →
-// 1.460, dilo 1.956 → 1.791) for about 25% more Newton iterations; 128 and 256 gained < 2% more.
-constexpr double kTauPowers[] = {2, 4, 8, 16, 32, 64};
-// Newton iterations per continuation stage: each stage only needs to move the maximum, and
-// the stages follow each other closely.
-constexpr int kTauStageIterations = 15;
-// Newton-decrement stop of the intermediate stages: each only hands its layout to the next
-// exponent; the last stage converges to kFinalTolerance.
-constexpr double kTauStageTolerance = 1e-5;
 // Alg. 3: largest penalty weight (× area / Σ feature edge²) of the soft feature stages, and the
 // extra ×10 stages after the L^p continuation.
 constexpr double kMaxSoftFeatureWeight = 1e9;

@@ -83,6 +83,10 @@ struct ConstrainedLayoutOptions {
   // One copy per component keeps its current position (the translation gauge); -1 = the first
   // copy of the component.
   std::vector<int> gauge_copies;
+  // After the symmetric Dirichlet solve: L^p stages (density (SD/4)^p) at these powers, each a
+  // few Newton iterations from the previous one, towards the map's largest distortion (τ, as the
+  // continuation of param::compute_seamless_param). Empty = none.
+  std::vector<double> tau_powers;
 };
 
 // The reduced parametrization of the final constraint space: x = P·y + c over all variables
