@@ -265,7 +265,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   const int n_steps =
       static_cast<int>(std::ceil(0.5 / options.threshold_step - 1e-9));  // batches
   int extra_steps = 0;  // last batches again, for seams deferred by the last one
-  std::vector<int> times_deferred(n_seams, 0);
+  std::vector<int> deferred_choice(n_seams, INT_MIN);  // the matching a deferral undid
   for (int step = 0; step < n_steps + extra_steps; ++step) {
     if (options.progress) options.progress("round", std::min(step, n_steps - 1), n_steps);
     const double eps = batch_threshold(options, std::min(step, n_steps - 1));
@@ -298,9 +298,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     for (size_t i = 0; i < batch.size(); ++i) {
       const double ms = m[batch[i]];
       chosen[i] = static_cast<int>(std::lround(ms));
-      // A seam deferred an odd number of times takes its second-nearest integer this time.
-      if (times_deferred[batch[i]] % 2 == 1) {
-        chosen[i] += ms >= std::round(ms) ? 1 : -1;
+      // A deferred seam does not take the integer that flipped last time: its second-nearest.
+      if (deferred_choice[batch[i]] != INT_MIN) {
+        if (chosen[i] == deferred_choice[batch[i]]) chosen[i] += ms >= std::round(ms) ? 1 : -1;
         continue;
       }
       if (options.local_estimation &&
@@ -474,10 +474,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       redo_batch();
     }
     // Still flipped: the batch's seams near the flipped faces (two vertex rings) wait for the
-    // next batch, measured again on the layout re-optimized with the others rounded; the last
-    // batch is repeated for them at most kMaxDeferredBatches times. (On mannequin-devil smoothed
-    // at 0.86 quad edges the fourth of five batches left 4 faces flipped and the parametrization
-    // failed.)
+    // next batch, measured again on the layout re-optimized with the others rounded, where they
+    // avoid the integer they had; the last batch is repeated for them at most
+    // kMaxDeferredBatches times. (On mannequin-devil smoothed at 0.86 quad edges the fourth of
+    // five batches left 4 faces flipped and the parametrization failed; deferred with their
+    // nearest integers kept, the same seams failed again alone.)
     if (tr.n_flipped > 0 &&
         (!last || extra_steps < kMaxDeferredBatches)) {
       const std::vector<char> near = near_flips();
@@ -486,8 +487,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         const CutSeam& cs = cut.seams[s];
         const int f = cs.he_a / 3, k = cs.he_a % 3;
         if (near[mesh.F(f, k)] || near[mesh.F(f, (k + 1) % 3)]) {
+          deferred_choice[s] = matching[s];
           matching[s] = INT_MIN;
-          ++times_deferred[s];
         }
         else
           kept.push_back(s);
