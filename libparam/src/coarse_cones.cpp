@@ -20,6 +20,8 @@ namespace {
 // A smoothed face whose area is below this fraction of the mean face area counts as collapsed:
 // the parametrization of such a copy is ill-conditioned, so the coarse cones are not tried.
 constexpr double kMinSmoothedAreaRatio = 1e-8;
+// Fractions of the input blended into a smoothed copy that has a collapsed face, tried in turn.
+constexpr double kInputBlend[] = {0, 0.1, 0.3};
 // build_copy_layout's seam tolerance (× UV bbox diagonal) for the smoothed map carried over:
 // compute_seamless_param guarantees ParamOptions::seam_tol × the copy's bbox diagonal, and the
 // re-optimization imposes the seam rows exactly again.
@@ -87,14 +89,27 @@ core::Status smooth_for_cones(const core::TriMesh& mesh, double scale, core::Tri
   const Eigen::RowVector3d centroid = V.colwise().mean();
   V = ((V.rowwise() - centroid) * std::sqrt(total_area / new_area)).rowwise() + centroid;
   const double min_area = kMinSmoothedAreaRatio * total_area / std::max(nf, 1);
-  for (int f = 0; f < nf; ++f)
-    if (!(face_area(V, mesh.F, f) > min_area) ||
-        core::collinear3d(V.row(mesh.F(f, 0)), V.row(mesh.F(f, 1)), V.row(mesh.F(f, 2))))
-      return core::Status::invalid_input("smooth_for_cones: face " + std::to_string(f) +
-                                         " collapses at this scale");
-  smoothed->V = std::move(V);
-  smoothed->F = mesh.F;
-  return core::Status::ok();
+  auto collapsed_face = [&](const Eigen::MatrixX3d& W) {
+    for (int f = 0; f < nf; ++f)
+      if (!(face_area(W, mesh.F, f) > min_area) ||
+          core::collinear3d(W.row(mesh.F(f, 0)), W.row(mesh.F(f, 1)), W.row(mesh.F(f, 2))))
+        return f;
+    return -1;
+  };
+  // A thin part that the flow collapses to a curve (dragon at 1.4 quad edges) keeps a little of
+  // its own shape: the copy is blended with the input, as little as makes every face proper.
+  int f_collapsed = -1;
+  for (const double keep : kInputBlend) {
+    const Eigen::MatrixX3d W = (1 - keep) * V + keep * mesh.V;
+    f_collapsed = collapsed_face(W);
+    if (f_collapsed < 0) {
+      smoothed->V = W;
+      smoothed->F = mesh.F;
+      return core::Status::ok();
+    }
+  }
+  return core::Status::invalid_input("smooth_for_cones: face " + std::to_string(f_collapsed) +
+                                     " collapses at this scale");
 }
 
 ParamResult relayout_on_mesh(const core::TriMesh& mesh, const ParamResult& seamless,

@@ -21,8 +21,9 @@ namespace quadify::param {
 // One implicit step of the cotangent-Laplacian heat flow, (M + t·L) V' = M V with t = scale²
 // (M lumped masses, L the cotangent Laplacian with negative weights clamped to zero so that the
 // system stays SPD), rescaled about the centroid to the input's surface area. Same faces.
-// Returns kNumericalFailure when the factorization fails, kInvalidInput when scale ≤ 0 or the
-// result has a degenerate face (a smoothing this strong collapsed a thin part).
+// A copy with a degenerate face (a thin part collapsed to a curve) is blended with the input,
+// 10% then 30% of it. Returns kNumericalFailure when the factorization fails, kInvalidInput
+// when scale ≤ 0 or even the 30% blend has a degenerate face.
 [[nodiscard]] core::Status smooth_for_cones(const core::TriMesh& mesh, double scale,
                                             core::TriMesh* smoothed);
 
