@@ -487,9 +487,10 @@ CommandRunner register_remesh(CLI::App& app) {
          [args](const std::string& text) { args->cone_scale = text == "auto" ? -1 : std::stod(text); },
          "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
          "curvature details smaller than that make no cones of their own; ignored while features are "
-         "aligned. 0 = off; auto (the default): 1.4 when the feature-free map has more than one cone "
-         "per 40 target quads beyond the 4|Euler characteristic| a closed surface needs (its cone "
-         "count is then param.fine_cones in the report), else off")
+         "aligned. 0 = off; auto (the default): 1.4, then 1.96 if that copy cannot be used, when the "
+         "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
+         "characteristic| a closed surface needs (its cone count is then param.fine_cones in the "
+         "report), else off")
       ->check([](const std::string& text) {
         if (text == "auto") return std::string();
         return CLI::NonNegativeNumber(text);
