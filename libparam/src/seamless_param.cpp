@@ -479,8 +479,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // kMaxDeferredBatches times. (On mannequin-devil smoothed at 0.86 quad edges the fourth of
     // five batches left 4 faces flipped and the parametrization failed; deferred with their
     // nearest integers kept, the same seams failed again alone.)
-    if (tr.n_flipped > 0 &&
-        (!last || extra_steps < kMaxDeferredBatches)) {
+    if (tr.n_flipped > 0 && (!last || extra_steps < kMaxDeferredBatches)) {
       const std::vector<char> near = near_flips();
       std::vector<int> kept;
       for (const int s : batch) {
@@ -489,9 +488,9 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         if (near[mesh.F(f, k)] || near[mesh.F(f, (k + 1) % 3)]) {
           deferred_choice[s] = matching[s];
           matching[s] = INT_MIN;
-        }
-        else
+        } else {
           kept.push_back(s);
+        }
       }
       if (kept.size() < batch.size()) {
         out.stats.n_deferred_matchings += static_cast<int>(batch.size() - kept.size());
