@@ -7,9 +7,9 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <numbers>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -359,22 +359,22 @@ class Extractor {
   // vertex of valence 1 or 0: no quad mesh has one, and the tracing cannot turn there.
   core::Status check_cone_angles() const {
     std::vector<double> angle(map_.mesh.n_vertices(), 0.0);
-    std::vector<char> on_boundary(map_.mesh.n_vertices(), 0);
     for (int f = 0; f < nf_; ++f)
       for (int k = 0; k < 3; ++k) {
-        const int v = map_.mesh.F(f, k);
-        if (twin_[3 * f + k] < 0) on_boundary[v] = on_boundary[map_.mesh.F(f, (k + 1) % 3)] = 1;
         const Eigen::Vector2d a = uv(f, (k + 1) % 3) - uv(f, k), b = uv(f, (k + 2) % 3) - uv(f, k);
-        angle[v] += std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+        angle[map_.mesh.F(f, k)] += std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
       }
-    for (int v = 0; v < map_.mesh.n_vertices(); ++v)
-      if (!on_boundary[v] && fan_start_[v] >= 0 && angle[v] < 0.75 * std::numbers::pi) {
+    for (int v = 0; v < map_.mesh.n_vertices(); ++v) {
+      const int c0 = fan_start_[v];
+      if (c0 < 0 || twin_[c0] < 0) continue;  // unused or boundary vertex (fan from its border)
+      if (angle[v] < 0.75 * std::numbers::pi) {
         const int index = static_cast<int>(std::lround(4 - angle[v] / (0.5 * std::numbers::pi)));
         return core::Status::invalid_input(
             "extract_quads: cone vertex " + std::to_string(v) + " has index " + std::to_string(index) +
             " (UV angle " + std::to_string(static_cast<int>(std::lround(angle[v] * 180 / std::numbers::pi))) +
             "°): it would be a quad vertex of valence " + std::to_string(4 - index) + ", which no quad mesh has");
       }
+    }
     return core::Status::ok();
   }
 
