@@ -57,14 +57,19 @@ struct PathSearch {
   std::vector<SeamChange> path;
   std::vector<int> visited;
   std::vector<ConePairCancellation>* found;
+  // false: paths end at a negative cone (cancellation); true: every regular vertex on the way
+  // is an end (splits).
+  bool to_regular = false;
 
   void extend(int v, double length) {
     for (const SeamStep& st : adjacency[v]) {
       const double l = length + st.length;
-      if (l > max_length || excluded[st.to]) continue;
+      // Splits may always take one seam edge, however long (a coarse tessellation at a tip).
+      if ((l > max_length && !(to_regular && path.empty())) || excluded[st.to]) continue;
       if (std::find(visited.begin(), visited.end(), st.to) != visited.end()) continue;
       path.push_back({st.seam, st.orientation});
-      if (index[st.to] < 0) {
+      if (to_regular && index[st.to] == 0) found->push_back({source, st.to, l, path});
+      if (!to_regular && index[st.to] < 0) {
         found->push_back({source, st.to, l, path});
       } else if (index[st.to] == 0 && static_cast<int>(path.size()) < max_hops) {
         visited.push_back(st.to);
@@ -75,6 +80,19 @@ struct PathSearch {
     }
   }
 };
+
+// Per vertex, the seam edges at it as steps to their other end.
+std::vector<std::vector<SeamStep>> seam_adjacency(const core::TriMesh& mesh, const CutMesh& cut) {
+  std::vector<std::vector<SeamStep>> adjacency(mesh.n_vertices());
+  for (int s = 0; s < static_cast<int>(cut.seams.size()); ++s) {
+    const int f = cut.seams[s].he_a / 3, k = cut.seams[s].he_a % 3;
+    const int v0 = mesh.F(f, k), v1 = mesh.F(f, (k + 1) % 3);
+    const double l = seam_length(cut, s);
+    adjacency[v0].push_back({v1, s, +1, l});
+    adjacency[v1].push_back({v0, s, -1, l});
+  }
+  return adjacency;
+}
 
 }  // namespace
 
@@ -90,14 +108,7 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
   std::vector<char> excluded = boundary_vertices(mesh, cut);
   for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
     if (avoid[v]) excluded[v] = 1;
-  std::vector<std::vector<SeamStep>> adjacency(nv);
-  for (int s = 0; s < static_cast<int>(cut.seams.size()); ++s) {
-    const int f = cut.seams[s].he_a / 3, k = cut.seams[s].he_a % 3;
-    const int v0 = mesh.F(f, k), v1 = mesh.F(f, (k + 1) % 3);
-    const double l = seam_length(cut, s);
-    adjacency[v0].push_back({v1, s, +1, l});
-    adjacency[v1].push_back({v0, s, -1, l});
-  }
+  const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
   std::vector<ConePairCancellation> candidates;
   for (int p = 0; p < nv; ++p) {
     if (index[p] <= 0 || excluded[p]) continue;
@@ -114,6 +125,66 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
     if (std::any_of(c.changes.begin(), c.changes.end(), [&](const SeamChange& ch) { return used_seam[ch.seam]; }))
       continue;
     used_vertex[c.positive_vertex] = used_vertex[c.negative_vertex] = 1;
+    for (const SeamChange& ch : c.changes) used_seam[ch.seam] = 1;
+    result.push_back(c);
+  }
+  return result;
+}
+
+std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, const CutMesh& cut,
+                                                   const std::vector<int>& index, int max_index,
+                                                   double distance, int max_hops,
+                                                   const std::vector<char>& avoid) {
+  std::vector<ConePairCancellation> result;
+  if (!(distance > 0) || max_hops < 1) return result;
+  const int nv = mesh.n_vertices();
+  std::vector<char> excluded = boundary_vertices(mesh, cut);
+  for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
+    if (avoid[v]) excluded[v] = 1;
+  const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
+  // Positive cones, and those crowded by another one closer than half the distance (the one of
+  // each such pair with the larger id moves).
+  std::vector<int> positive;
+  for (int v = 0; v < nv; ++v)
+    if (index[v] > 0 && !excluded[v]) positive.push_back(v);
+  const double crowd = 0.5 * distance;
+  auto near_positive = [&](int v, int skip) {
+    for (const int q : positive)
+      if (q != skip && (mesh.V.row(q) - mesh.V.row(v)).norm() < crowd) return true;
+    return false;
+  };
+  std::vector<ConePairCancellation> candidates;
+  for (const int p : positive) {
+    bool crowded = false;
+    for (const int q : positive)
+      if (q < p && (mesh.V.row(q) - mesh.V.row(p)).norm() < crowd) crowded = true;
+    if (index[p] <= max_index && !crowded) continue;
+    PathSearch search{adjacency, index, excluded, 2 * distance, max_hops, p, {}, {p}, &candidates, true};
+    search.extend(p, 0.0);
+  }
+  // Targets clear of the other positive cones (a cone that keeps some of its index counts).
+  std::vector<ConePairCancellation> clear;
+  for (ConePairCancellation& c : candidates)
+    if (!near_positive(c.negative_vertex, index[c.positive_vertex] > 1 ? -1 : c.positive_vertex))
+      clear.push_back(std::move(c));
+  auto miss = [distance](const ConePairCancellation& c) { return std::abs(c.path_length - distance); };
+  std::sort(clear.begin(), clear.end(), [&](const auto& a, const auto& b) {
+    return std::make_tuple(miss(a), a.positive_vertex, a.negative_vertex) <
+           std::make_tuple(miss(b), b.positive_vertex, b.negative_vertex);
+  });
+  std::vector<char> used_vertex(nv, 0), used_seam(cut.seams.size(), 0);
+  std::vector<int> targets;
+  for (const ConePairCancellation& c : clear) {
+    if (used_vertex[c.positive_vertex] || used_vertex[c.negative_vertex]) continue;
+    if (std::any_of(c.changes.begin(), c.changes.end(), [&](const SeamChange& ch) { return used_seam[ch.seam]; }))
+      continue;
+    // Two new cones of one pass stay apart too.
+    if (std::any_of(targets.begin(), targets.end(), [&](int t) {
+          return (mesh.V.row(t) - mesh.V.row(c.negative_vertex)).norm() < crowd;
+        }))
+      continue;
+    used_vertex[c.positive_vertex] = used_vertex[c.negative_vertex] = 1;
+    targets.push_back(c.negative_vertex);
     for (const SeamChange& ch : c.changes) used_seam[ch.seam] = 1;
     result.push_back(c);
   }

@@ -85,6 +85,10 @@ constexpr int kConePairPasses = 4;
 // With direction alignment, a cancellation may raise the map's mean angle to the directions by at
 // most this (degrees).
 constexpr double kMaxCancellationAngleLoss = 0.5;
+// Passes of cone splitting (a cone of index k loses one unit per pass) and the seam edges of a
+// split's path.
+constexpr int kConeSplitPasses = 4;
+constexpr int kConeSplitHops = 64;
 // A cancellation may raise the map's τ to at most max(floor, growth × τ before the pass).
 constexpr double kCancellationTauFloor = 5;
 constexpr double kCancellationTauGrowth = 2;
@@ -540,118 +544,136 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     if (rep.status.is_ok()) x = red.expand(y);
     out.stats.seconds_optimize += seconds_since(to);
   }
-  // Cone-pair cancellation: change the matchings of a set of pairs' seam paths, rebuild the
-  // constraint space without those seams' old rows, and move the layout into the new rows like a
-  // batch. A set that cannot be made flip-free is split in halves.
+  // Matching changes along seam paths (cone-pair cancellations, cone splits): change the
+  // matchings of a set of paths, rebuild the constraint space without those seams' old rows, and
+  // move the layout into the new rows like a batch. A set that cannot be made flip-free (or that
+  // raises τ beyond max(kCancellationTauFloor, kCancellationTauGrowth × τ before)) is split in
+  // halves; returns the number of paths applied. Counts failures.
+  int move_failures = 0;
+  std::function<int(const std::vector<ConePairCancellation>&, size_t, size_t, double)> apply_moves =
+      [&](const std::vector<ConePairCancellation>& moves, size_t begin, size_t end, double tau_before) -> int {
+    if (begin >= end || move_failures >= kMaxCancellationFailures) return 0;
+    std::vector<int> new_matching = matching;
+    std::vector<char> changed(n_seams, 0);
+    for (size_t i = begin; i < end; ++i)
+      for (const SeamChange& ch : moves[i].changes) {
+        new_matching[ch.seam] += ch.delta;
+        changed[ch.seam] = 1;
+      }
+    std::vector<int> kept_matching = matching;
+    for (int s = 0; s < n_seams; ++s)
+      if (changed[s]) kept_matching[s] = INT_MIN;
+    ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
+    for (const SparseRow& row : feature_rows) kept.add_row(row);
+    const Reduction kept_red = kept.reduction(x);
+    Eigen::VectorXd x_try = x;
+    ConstraintEliminator full = eliminate_seams(cut, new_matching);
+    for (const SparseRow& row : feature_rows) full.add_row(row);
+    std::vector<SparseRow> new_rows;
+    double edge_sq = 0;
+    for (int s = 0; s < n_seams; ++s)
+      if (changed[s]) {
+        for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s])) new_rows.push_back(row);
+        edge_sq += seam_length(cut, s) * seam_length(cut, s);
+      }
+    TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows, total_area / edge_sq, &x_try,
+                                                n_copy_vars, kCancellationPenaltyStages);
+    out.stats.total_iterations += tr.iterations;
+    out.stats.n_transition_iterations += tr.iterations;
+    add_timers(tr.timers, &out.stats);
+    bool ok = tr.status.is_ok() && tr.n_flipped == 0;
+    if (ok) {
+      Eigen::VectorXd y = tr.reduction.restrict(x_try);
+      OptimizeSettings st;
+      st.density = density;
+      st.power = power;
+      st.max_iterations = options.max_newton_iters;
+      st.relative_tolerance = options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
+      update_penalty_rows();
+      st.penalty_rows = penalty_rows;
+      st.penalty_weight = 1;
+      const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
+      out.stats.total_iterations += rep.iterations;
+      out.stats.n_batch_iterations += rep.iterations;
+      add_timers(rep.timers, &out.stats);
+      if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
+      // Flip-free is not enough: a face the move squashed to a sliver (dragon: τ 3·10⁷)
+      // passes the exact orientation test and leaves quantization no room.
+      ok = count_flipped(domain, x_try) == 0 &&
+           max_isometric_distortion(domain, x_try) <=
+               std::max(kCancellationTauFloor, kCancellationTauGrowth * tau_before);
+      // With directions to follow, a set whose cones the field needs (its alignment gets
+      // worse) is kept: on an ellipsoid with anisotropic sizing, cancelling 9 pairs raised
+      // the map's angle to the principal directions from 5.7° to 14.4°.
+      if (ok && directions.size() > 0)
+        ok = direction_angle_mean(domain, directions, x_try) <=
+             direction_angle_mean(domain, directions, x) + kMaxCancellationAngleLoss;
+    }
+    if (ok) {
+      matching = std::move(new_matching);
+      elim = std::move(full);
+      red_problem.reset();
+      red = std::move(tr.reduction);
+      x = std::move(x_try);
+      return static_cast<int>(end - begin);
+    }
+    ++move_failures;
+    if (end - begin < 2) return 0;
+    const size_t mid = begin + (end - begin) / 2;
+    const int first = apply_moves(moves, begin, mid, tau_before);
+    return first + apply_moves(moves, mid, end, tau_before);
+  };
+  // Vertices of the aligned features: a matching change there may turn a feature's u/v label
+  // across the seam against its rows.
+  std::vector<char> feature_vertices(mesh.n_vertices(), 0);
+  for (int i = 0; i < fs.size(); ++i)
+    if (label[i] == 0 || label[i] == 1) {
+      const int h = fs.halfedge[i];
+      feature_vertices[mesh.F(h / 3, h % 3)] = feature_vertices[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
+    }
+  // Cone-pair cancellation. A set that cannot be made flip-free is split in halves.
   if (options.cone_pair_distance > 0 && out.status.is_ok()) {
     const auto to = Clock::now();
-    int failures = 0;
     // A matching change at an aligned feature may turn its u/v label across the seam against
     // the feature rows, and one such pair makes its whole set fail. If no pair could be
     // cancelled at all, the pairs whose paths stay off the aligned features' vertices are tried
     // on their own, with a new failure budget (feline at 5,000 quads, 69 aligned creases: none
     // of 235 pairs cancelled, 676 cones; now 194 pairs, 295 cones). Only then: elsewhere the
     // pairs at features cancel too (block: 18 pairs, 11 of them at features).
-    std::vector<char> avoid(mesh.n_vertices(), 0);
-    for (int i = 0; i < fs.size(); ++i)
-      if (label[i] == 0 || label[i] == 1) {
-        const int h = fs.halfedge[i];
-        avoid[mesh.F(h / 3, h % 3)] = avoid[mesh.F(h / 3, (h % 3 + 1) % 3)] = 1;
-      }
     // Passes of cancellation over the pairs whose paths avoid `avoid_vertices` (#V or empty).
     auto cancel_passes = [&](const std::vector<char>& avoid_vertices) {
-      for (int pass = 0; pass < kConePairPasses && failures < kMaxCancellationFailures; ++pass) {
+      for (int pass = 0; pass < kConePairPasses && move_failures < kMaxCancellationFailures; ++pass) {
         const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
             mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
             options.cone_pair_max_hops, avoid_vertices);
         if (pairs.empty()) break;
-        const int cancelled_before = out.stats.n_cancelled_pairs;
-        const double tau_before = max_isometric_distortion(domain, x);
-        std::function<void(size_t, size_t)> apply = [&](size_t begin, size_t end) {
-          if (begin >= end || failures >= kMaxCancellationFailures) return;
-          std::vector<int> new_matching = matching;
-          std::vector<char> changed(n_seams, 0);
-          for (size_t i = begin; i < end; ++i)
-            for (const SeamChange& ch : pairs[i].changes) {
-              new_matching[ch.seam] += ch.delta;
-              changed[ch.seam] = 1;
-            }
-          std::vector<int> kept_matching = matching;
-          for (int s = 0; s < n_seams; ++s)
-            if (changed[s]) kept_matching[s] = INT_MIN;
-          ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
-          for (const SparseRow& row : feature_rows) kept.add_row(row);
-          const Reduction kept_red = kept.reduction(x);
-          Eigen::VectorXd x_try = x;
-          ConstraintEliminator full = eliminate_seams(cut, new_matching);
-          for (const SparseRow& row : feature_rows) full.add_row(row);
-          std::vector<SparseRow> new_rows;
-          double edge_sq = 0;
-          for (int s = 0; s < n_seams; ++s)
-            if (changed[s]) {
-              for (const SparseRow& row : seam_constraint_rows(cut, s, new_matching[s]))
-                new_rows.push_back(row);
-              edge_sq += seam_length(cut, s) * seam_length(cut, s);
-            }
-          TransitionReport tr = move_into_constraints(domain, kept_red, full, new_rows,
-                                                      total_area / edge_sq, &x_try, n_copy_vars,
-                                                      kCancellationPenaltyStages);
-          out.stats.total_iterations += tr.iterations;
-          out.stats.n_transition_iterations += tr.iterations;
-          add_timers(tr.timers, &out.stats);
-          bool ok = tr.status.is_ok() && tr.n_flipped == 0;
-          if (ok) {
-            Eigen::VectorXd y = tr.reduction.restrict(x_try);
-            OptimizeSettings st;
-            st.density = density;
-            st.power = power;
-            st.max_iterations = options.max_newton_iters;
-            st.relative_tolerance =
-                options.energy != Energy::kTau ? kFinalTolerance : kBatchTolerance;
-            update_penalty_rows();
-            st.penalty_rows = penalty_rows;
-            st.penalty_weight = 1;
-            const OptimizeReport rep = optimize_layout(domain, tr.reduction, st, &y);
-            out.stats.total_iterations += rep.iterations;
-            out.stats.n_batch_iterations += rep.iterations;
-            add_timers(rep.timers, &out.stats);
-            if (rep.status.is_ok()) x_try = tr.reduction.expand(y);
-            // Flip-free is not enough: a face the move squashed to a sliver (dragon: τ 3·10⁷)
-            // passes the exact orientation test and leaves quantization no room.
-            ok = count_flipped(domain, x_try) == 0 &&
-                 max_isometric_distortion(domain, x_try) <=
-                     std::max(kCancellationTauFloor, kCancellationTauGrowth * tau_before);
-            // With directions to follow, a set whose cones the field needs (its alignment gets
-            // worse) is kept: on an ellipsoid with anisotropic sizing, cancelling 9 pairs raised
-            // the map's angle to the principal directions from 5.7° to 14.4°.
-            if (ok && directions.size() > 0)
-              ok = direction_angle_mean(domain, directions, x_try) <=
-                   direction_angle_mean(domain, directions, x) + kMaxCancellationAngleLoss;
-          }
-          if (ok) {
-            matching = std::move(new_matching);
-            elim = std::move(full);
-            red_problem.reset();
-            red = std::move(tr.reduction);
-            x = std::move(x_try);
-            out.stats.n_cancelled_pairs += static_cast<int>(end - begin);
-            return;
-          }
-          ++failures;
-          if (end - begin < 2) return;
-          const size_t mid = begin + (end - begin) / 2;
-          apply(begin, mid);
-          apply(mid, end);
-        };
-        apply(0, pairs.size());
-        if (out.stats.n_cancelled_pairs == cancelled_before) break;
+        const int n = apply_moves(pairs, 0, pairs.size(), max_isometric_distortion(domain, x));
+        out.stats.n_cancelled_pairs += n;
+        if (n == 0) break;
       }
     };
     cancel_passes({});
-    if (out.stats.n_cancelled_pairs == 0 && failures > 0 &&
-        std::count(avoid.begin(), avoid.end(), 1) > 0) {
-      failures = 0;
-      cancel_passes(avoid);
+    if (out.stats.n_cancelled_pairs == 0 && move_failures > 0 &&
+        std::count(feature_vertices.begin(), feature_vertices.end(), 1) > 0) {
+      move_failures = 0;
+      cancel_passes(feature_vertices);
+    }
+    out.stats.seconds_optimize += seconds_since(to);
+  }
+  // Cone splitting: a cone of index 2 or more (a flat quad corner, or a quad vertex of valence
+  // 1 or less) gives one unit of index at a time to a regular vertex about
+  // cone_split_distance away along the seams.
+  if (options.cone_split_distance > 0 && out.status.is_ok()) {
+    const auto to = Clock::now();
+    move_failures = 0;
+    for (int pass = 0; pass < kConeSplitPasses && move_failures < kMaxCancellationFailures; ++pass) {
+      const std::vector<ConePairCancellation> splits =
+          find_cone_splits(mesh, cut, vertex_indices(mesh, cut, x), 1, options.cone_split_distance,
+                           kConeSplitHops, feature_vertices);
+      if (splits.empty()) break;
+      const int n = apply_moves(splits, 0, splits.size(), max_isometric_distortion(domain, x));
+      out.stats.n_split_cones += n;
+      if (n == 0) break;
     }
     out.stats.seconds_optimize += seconds_since(to);
   }
@@ -843,6 +865,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
     return core::Status::invalid_input("threshold_step must be in (0, 0.5]");
   if (o.patch_bfs_levels < 1) return core::Status::invalid_input("patch_bfs_levels must be >= 1");
   if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
+  if (!(o.cone_split_distance >= 0))
+    return core::Status::invalid_input("cone_split_distance must be >= 0");
   if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
     return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
   if (!(o.cone_scale >= 0) || !std::isfinite(o.cone_scale))
@@ -1073,6 +1097,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_improved += o.stats.n_improved;
     st.n_batches = std::max(st.n_batches, o.stats.n_batches);
     st.n_cancelled_pairs += o.stats.n_cancelled_pairs;
+    st.n_split_cones += o.stats.n_split_cones;
     st.n_deferred_matchings += o.stats.n_deferred_matchings;
     st.total_iterations += o.stats.total_iterations;
     st.n_flipped += o.stats.n_flipped;

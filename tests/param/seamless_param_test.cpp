@@ -12,6 +12,7 @@
 
 #include <filesystem>
 
+#include "../test_meshes.h"
 #include "test_meshes.h"
 #include "test_util.h"
 
@@ -166,6 +167,30 @@ TEST(SeamlessParam, ConePairCancellationRemovesClosePairs) {
           << "opposite cones left on seam edge " << s.edge_vertex0 << "-" << s.edge_vertex1;
     }
   }
+}
+
+// Cone splitting: the thin spike's apex gets a cone of index 3 (UV angle π/2, a quad vertex of
+// valence 1); with cone_split_distance every cone has index ≤ 1, the map stays flip-free and
+// seamless, Σ index stays 4χ, and the units moved off the apex are new +1 cones.
+TEST(SeamlessParam, ConeSplittingLeavesNoConeAboveIndexOne) {
+  const core::TriMesh mesh = test::spike();
+  auto max_index = [](const ParamResult& r) {
+    int m = 0;
+    for (const ConeInfo& k : r.cones) m = std::max(m, k.index);
+    return m;
+  };
+  const ParamResult plain = compute_seamless_param(mesh, ParamOptions{});
+  check_result("spike", mesh, plain);
+  ASSERT_GE(max_index(plain), 2) << "the test needs a cone of index 2 or more without splitting";
+  EXPECT_EQ(plain.stats.n_split_cones, 0);
+  ParamOptions split;
+  split.cone_split_distance = 1.5;  // model units: the spike is 8 high, its base of radius 1
+  const ParamResult r = compute_seamless_param(mesh, split);
+  const Checked c = check_result("spike (split)", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8);
+  EXPECT_LE(max_index(r), 1);
+  EXPECT_GE(r.stats.n_split_cones, max_index(plain) - 1);
+  EXPECT_EQ(r.stats.n_cones, plain.stats.n_cones + r.stats.n_split_cones);
 }
 
 TEST(SeamlessParam, TestDataMeshes) {

@@ -94,6 +94,13 @@ FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundar
   return run;
 }
 
+// A thin spike: the rounding gives its apex a cone of index 3 (a quad vertex of valence 1, which
+// extraction rejects); cone splitting (as the CLI does it, at one quad edge) spreads it into +1
+// cones, and the pipeline gives a valid pure-quad mesh of the spike.
+TEST(QuantizeSeamless, ThinSpikeExtractsWithItsApexConeSplit) {
+  expect_valid_quads("spike", test::spike(), 300, true);
+}
+
 TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
   const core::TriMesh mesh = load("box.obj");
   const FeatureRun run = run_with_features(mesh, 200, false);

@@ -85,6 +85,7 @@ inline PipelineRun run_pipeline(const core::TriMesh& mesh, int target_faces) {
   po.energy = param::Energy::kSymmetricDirichlet;
   po.cone_pair_distance = quantize::recommended_cone_pair_distance(mesh, qo);
   po.cone_pair_max_hops = quantize::kRecommendedConePairHops;
+  po.cone_split_distance = quantize::target_edge_length(mesh, qo);
   run.param = param::compute_seamless_param(mesh, po);
   run.seconds_param = since(t);
   if (!run.param.status.is_ok()) return run;

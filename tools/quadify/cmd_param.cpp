@@ -95,6 +95,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"patches", s.n_patches},
                      {"improved", s.n_improved},
                      {"cancelled_pairs", s.n_cancelled_pairs},
+                     {"split_cones", s.n_split_cones},
                      {"deferred_matchings", s.n_deferred_matchings},
                      {"coarse_cones", s.coarse_cones},
                      {"coarse_cones_fallback_reason", s.coarse_cones_fallback_reason},
@@ -183,6 +184,12 @@ CommandRunner register_param(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--cone-pair-hops", o.cone_pair_max_hops, "Seam edges of a cone-pair cancellation path")
       ->check(CLI::Range(1, 10))
+      ->capture_default_str();
+  app.add_option("--cone-split-distance", o.cone_split_distance,
+                 "Split every cone of index 2 or more (a quad vertex of valence 2 or less, made at the tips of "
+                 "thin parts) into cones of index 1, moving one unit of index at a time to a vertex about this "
+                 "far (model units) along the seams (0 = off, the paper)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--cone-scale", o.cone_scale,
                  "Round the matchings on a copy of the mesh smoothed at this length (model units), so that "

@@ -34,6 +34,7 @@ struct RemeshArgs {
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
+  double cone_split_distance = 1;  // × the target quad edge length
   double cone_scale = -1;         // × the target quad edge length, 0 = off, < 0 = auto
   double time_budget = 0;         // seconds for the quantization, 0 = none
   // Detected creases that are all shorter than this many target quad edges (no knife edge among
@@ -124,6 +125,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   param_options.cone_pair_distance =
       quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
+  param_options.cone_split_distance =
+      std::max(0.0, args.cone_split_distance) * quantize::target_edge_length(mesh, quantize_options);
   param_options.cone_scale = std::max(0.0, args.cone_scale) * quantize::target_edge_length(mesh, quantize_options);
   param_options.threads = common.threads;
   param_options.progress = on_progress;
@@ -184,6 +187,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         {"patches", ps.n_patches},
         {"improved", ps.n_improved},
         {"cancelled_pairs", ps.n_cancelled_pairs},
+        {"split_cones", ps.n_split_cones},
         {"deferred_matchings", ps.n_deferred_matchings},
         {"coarse_cones", ps.coarse_cones},
         {"coarse_cones_fallback_reason", coarse_reason.empty() ? ps.coarse_cones_fallback_reason : coarse_reason},
@@ -480,6 +484,13 @@ CommandRunner register_remesh(CLI::App& app) {
                  "shorter than this many quad edge lengths (and at least 8 mean edge lengths of the input), "
                  "by changing the matchings along the path: such pairs cannot sit on distinct grid points "
                  "and add two irregular vertices (0 = keep every cone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--cone-split-distance", args->cone_split_distance,
+                 "Split every cone of index 2 or more (a quad vertex of valence 2 or less: the rounding makes "
+                 "them at the tips of thin parts, such as tentacles) into cones of index 1, one unit of index "
+                 "at a time moved to a vertex about this many quad edge lengths away along the seams (0 = keep "
+                 "them; a cone of index 3 or more cannot be extracted)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option_function<std::string>(

@@ -62,6 +62,13 @@ struct ParamOptions {
   // points of a grid coarser than their distance. 0 = off (the paper's method).
   double cone_pair_distance = 0;
   int cone_pair_max_hops = 3;
+  // Cone splitting (not in the paper; for quad meshing): after the cancellation, a cone of index
+  // 2 or more (UV angle π or less: a flat quad corner, or a quad vertex of valence 1 or 0; the
+  // rounding makes them at the tips of thin parts, such as octopus's tentacles) gives one unit of
+  // index at a time to a regular vertex whose path along the seams (≤ 64 edges, through regular
+  // vertices, off aligned features) is closest to this length (model units) and at most twice
+  // it, followed by the flip-free re-optimization of the cancellation. 0 = off (the paper).
+  double cone_split_distance = 0;
   // Coarse cones (not in the paper; for quad meshing at coarse densities): when > 0, the
   // matchings are rounded (Alg. 1, with the cone-pair cancellation) on a copy of the mesh
   // smoothed at this length (model units; one implicit cotangent-Laplacian heat step of time
@@ -150,6 +157,7 @@ struct ParamStats {
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
+  int n_split_cones = 0;       // units of index moved off cones of index ≥ 2 (cone splitting)
   int n_deferred_matchings = 0;  // seams whose rounding a batch deferred (flips near them)
   bool coarse_cones = false;   // the matchings were rounded on the smoothed copy (cone_scale)
   std::string coarse_cones_fallback_reason;  // why cone_scale was asked for but not used
