@@ -94,6 +94,14 @@ std::vector<std::vector<SeamStep>> seam_adjacency(const core::TriMesh& mesh, con
   return adjacency;
 }
 
+// Vertices no path may touch: the boundary and `avoid` (#V flags, or empty).
+std::vector<char> excluded_vertices(const core::TriMesh& mesh, const CutMesh& cut, const std::vector<char>& avoid) {
+  std::vector<char> excluded = boundary_vertices(mesh, cut);
+  for (int v = 0; v < mesh.n_vertices() && v < static_cast<int>(avoid.size()); ++v)
+    if (avoid[v]) excluded[v] = 1;
+  return excluded;
+}
+
 }  // namespace
 
 std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMesh& mesh,
@@ -104,10 +112,7 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
   std::vector<ConePairCancellation> result;
   if (!(max_length > 0) || max_hops < 1) return result;
   const int nv = mesh.n_vertices();
-  // Vertices no path may touch: the boundary and `avoid`.
-  std::vector<char> excluded = boundary_vertices(mesh, cut);
-  for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
-    if (avoid[v]) excluded[v] = 1;
+  const std::vector<char> excluded = excluded_vertices(mesh, cut, avoid);
   const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
   std::vector<ConePairCancellation> candidates;
   for (int p = 0; p < nv; ++p) {
@@ -138,12 +143,10 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
   std::vector<ConePairCancellation> result;
   if (!(distance > 0) || max_hops < 1) return result;
   const int nv = mesh.n_vertices();
-  std::vector<char> excluded = boundary_vertices(mesh, cut);
-  for (int v = 0; v < nv && v < static_cast<int>(avoid.size()); ++v)
-    if (avoid[v]) excluded[v] = 1;
+  const std::vector<char> excluded = excluded_vertices(mesh, cut, avoid);
   const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
-  // Positive cones, and those crowded by another one closer than half the distance (the one of
-  // each such pair with the larger id moves).
+  // Positive cones; those above max_index, or crowded by another one closer than half the
+  // distance, move.
   std::vector<int> positive;
   for (int v = 0; v < nv; ++v)
     if (index[v] > 0 && !excluded[v]) positive.push_back(v);
@@ -155,10 +158,7 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
   };
   std::vector<ConePairCancellation> candidates;
   for (const int p : positive) {
-    bool crowded = false;
-    for (const int q : positive)
-      if (q < p && (mesh.V.row(q) - mesh.V.row(p)).norm() < crowd) crowded = true;
-    if (index[p] <= max_index && !crowded) continue;
+    if (index[p] <= max_index && !near_positive(p, p)) continue;
     PathSearch search{adjacency, index, excluded, 2 * distance, max_hops, p, {}, {p}, &candidates, true};
     search.extend(p, 0.0);
   }
@@ -184,6 +184,9 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
         }))
       continue;
     used_vertex[c.positive_vertex] = used_vertex[c.negative_vertex] = 1;
+    // One cone of a crowded group moves per pass (the next pass sees what is left).
+    for (const int q : positive)
+      if ((mesh.V.row(q) - mesh.V.row(c.positive_vertex)).norm() < crowd) used_vertex[q] = 1;
     targets.push_back(c.negative_vertex);
     for (const SeamChange& ch : c.changes) used_seam[ch.seam] = 1;
     result.push_back(c);

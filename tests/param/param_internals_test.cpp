@@ -81,6 +81,49 @@ TEST(ConePairs, PathsAvoidFlaggedVertices) {
   }
 }
 
+// Splits: a cone of index 3 gives one unit per call to a regular vertex about `distance` away
+// along the seams; two +1 cones closer than distance/2 are crowded and the one with the larger
+// id moves; every target is regular, at least distance/2 from every other positive cone, and
+// the moves change the index by the path's ends only (the sign rule of the header: −1 at the
+// start, +1 at the end). Of a crowded pair one cone moves.
+TEST(ConeSplits, MoveUnitsOffHighIndexAndCrowdedCones) {
+  const core::TriMesh m = test::make_icosphere(3);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  const double distance = 0.5;  // the unit sphere's edges are about 0.08 long at 3 subdivisions
+  std::vector<int> index(m.n_vertices(), 0);
+  index[0] = 3;
+  const std::vector<ConePairCancellation> one = find_cone_splits(m, cut, index, 1, distance, 64);
+  ASSERT_EQ(one.size(), 1u);
+  EXPECT_EQ(one[0].positive_vertex, 0);
+  EXPECT_EQ(index[one[0].negative_vertex], 0);
+  EXPECT_LE(one[0].path_length, 2 * distance);
+  EXPECT_GE((m.V.row(one[0].negative_vertex) - m.V.row(0)).norm(), 0.5 * distance);
+  // The changes move one unit from the start to the end: per vertex, +delta lowers the seam's
+  // first vertex and raises its second.
+  std::vector<int> moved(m.n_vertices(), 0);
+  for (const SeamChange& ch : one[0].changes) {
+    const int g = cut.seams[ch.seam].he_a / 3, j = cut.seams[ch.seam].he_a % 3;
+    moved[m.F(g, j)] -= ch.delta;
+    moved[m.F(g, (j + 1) % 3)] += ch.delta;
+  }
+  for (int v = 0; v < m.n_vertices(); ++v)
+    EXPECT_EQ(moved[v], v == 0 ? -1 : v == one[0].negative_vertex ? 1 : 0) << v;
+  // A crowded pair of +1 cones (a seam edge apart): one moves, away from the other.
+  index.assign(m.n_vertices(), 0);
+  const int f = cut.seams[0].he_a / 3, k = cut.seams[0].he_a % 3;
+  const int a = m.F(f, k), b = m.F(f, (k + 1) % 3);
+  index[a] = index[b] = 1;
+  const std::vector<ConePairCancellation> crowd = find_cone_splits(m, cut, index, 1, distance, 64);
+  ASSERT_EQ(crowd.size(), 1u);
+  const int stays = crowd[0].positive_vertex == a ? b : a;
+  EXPECT_TRUE(crowd[0].positive_vertex == a || crowd[0].positive_vertex == b);
+  EXPECT_GE((m.V.row(crowd[0].negative_vertex) - m.V.row(stays)).norm(), 0.5 * distance);
+  // Far apart, nothing to do.
+  index.assign(m.n_vertices(), 0);
+  index[0] = 1;
+  EXPECT_TRUE(find_cone_splits(m, cut, index, 1, distance, 64).empty());
+}
+
 TEST(CutLayout, IsometricUnfoldHasUnitSingularValues) {
   for (const core::TriMesh& m : {test::make_icosphere(2), test::make_torus(20, 8), test::make_disk(5, 12)}) {
     const CutMesh cut = cut_along_dual_tree(m, 0);
