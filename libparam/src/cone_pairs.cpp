@@ -158,7 +158,7 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
   };
   std::vector<ConePairCancellation> candidates;
   for (const int p : positive) {
-    if (index[p] <= max_index && !near_positive(p, p)) continue;
+    if (index[p] <= max_index && !(max_index == 1 && near_positive(p, p))) continue;
     PathSearch search{adjacency, index, excluded, 2 * distance, max_hops, p, {}, {p}, &candidates, true};
     search.extend(p, 0.0);
   }

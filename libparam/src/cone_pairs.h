@@ -54,16 +54,16 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
 
 // Splits of cones of index above max_index (a quad vertex of valence 4 − index: index 2 gives a
 // flat corner, index 3 a valence-1 vertex, which no quad mesh has; the rounding makes them at the
-// tips of thin parts), and moves of positive cones crowded by another positive cone closer than
-// distance/2 (3D; one cone of such a group moves per call, the first chosen; the rounding leaves such
-// clusters at tips, where the grid cannot put them on distinct points): for each such interior
-// cone p, a path of at most max_hops seam edges to a regular interior vertex q, through regular
-// interior vertices, whose 3D length is closest to `distance` (at most 2·distance, or a single
-// edge), with q at
-// least distance/2 from every other positive cone and from the other targets. Applying it moves
-// one unit of index from p to q (q becomes a +1 cone). One move per cone per call, paths
-// disjoint; greedily by |length − distance| (ties by vertex ids: deterministic). `avoid` as
-// above. The result uses ConePairCancellation with negative_vertex = the target q.
+// tips of thin parts) and, with max_index 1, moves of +1 cones crowded by another positive cone
+// closer than distance/2 (3D; one cone of such a group moves per call, the first chosen; the
+// rounding leaves such clusters at tips, where the grid cannot put them on distinct points):
+// for each such interior cone p, a path of at most max_hops seam edges to a regular interior
+// vertex q, through regular interior vertices, whose 3D length is closest to `distance` (at
+// most 2·distance, or a single edge), with q at least distance/2 from every other positive cone
+// and from the other targets. Applying it moves one unit of index from p to q (q becomes a +1
+// cone). One move per cone per call, paths disjoint; greedily by |length − distance| (ties by
+// vertex ids: deterministic). `avoid` as above. The result uses ConePairCancellation with
+// negative_vertex = the target q.
 std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, const CutMesh& cut,
                                                    const std::vector<int>& index, int max_index,
                                                    double distance, int max_hops,

@@ -668,7 +668,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     move_failures = 0;
     for (int pass = 0; pass < kConeSplitPasses && move_failures < kMaxCancellationFailures; ++pass) {
       const std::vector<ConePairCancellation> splits =
-          find_cone_splits(mesh, cut, vertex_indices(mesh, cut, x), 1, options.cone_split_distance,
+          find_cone_splits(mesh, cut, vertex_indices(mesh, cut, x), options.cone_split_max_index,
+                           options.cone_split_distance,
                            kConeSplitHops, feature_vertices);
       if (splits.empty()) break;
       const int n = apply_moves(splits, 0, splits.size(), max_isometric_distortion(domain, x));
@@ -865,8 +866,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
     return core::Status::invalid_input("threshold_step must be in (0, 0.5]");
   if (o.patch_bfs_levels < 1) return core::Status::invalid_input("patch_bfs_levels must be >= 1");
   if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
-  if (!(o.cone_split_distance >= 0))
-    return core::Status::invalid_input("cone_split_distance must be >= 0");
+  if (!(o.cone_split_distance >= 0) || o.cone_split_max_index < 1 || o.cone_split_max_index > 2)
+    return core::Status::invalid_input("cone_split_distance must be >= 0 and cone_split_max_index 1 or 2");
   if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
     return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
   if (!(o.cone_scale >= 0) || !std::isfinite(o.cone_scale))

@@ -170,9 +170,10 @@ TEST(SeamlessParam, ConePairCancellationRemovesClosePairs) {
 }
 
 // Cone splitting: the thin spike's apex gets a cone of index 3 (UV angle π/2, a quad vertex of
-// valence 1); with cone_split_distance every cone has index ≤ 1, the map stays flip-free and
-// seamless, Σ index stays 4χ, and the units moved off the apex are new +1 cones.
-TEST(SeamlessParam, ConeSplittingLeavesNoConeAboveIndexOne) {
+// valence 1); with cone_split_distance no cone keeps an index above cone_split_max_index, the
+// map stays flip-free and seamless, Σ index stays 4χ, and the units moved off the apex are new
+// +1 cones.
+TEST(SeamlessParam, ConeSplittingLeavesNoConeAboveTheMaxIndex) {
   const core::TriMesh mesh = test::spike();
   auto max_index = [](const ParamResult& r) {
     int m = 0;
@@ -181,16 +182,20 @@ TEST(SeamlessParam, ConeSplittingLeavesNoConeAboveIndexOne) {
   };
   const ParamResult plain = compute_seamless_param(mesh, ParamOptions{});
   check_result("spike", mesh, plain);
-  ASSERT_GE(max_index(plain), 2) << "the test needs a cone of index 2 or more without splitting";
+  ASSERT_GE(max_index(plain), 3) << "the test needs a cone of index 3 without splitting";
   EXPECT_EQ(plain.stats.n_split_cones, 0);
-  ParamOptions split;
-  split.cone_split_distance = 1.5;  // model units: the spike is 8 high, its base of radius 1
-  const ParamResult r = compute_seamless_param(mesh, split);
-  const Checked c = check_result("spike (split)", mesh, r);
-  EXPECT_EQ(c.cone_sum, 8);
-  EXPECT_LE(max_index(r), 1);
-  EXPECT_GE(r.stats.n_split_cones, max_index(plain) - 1);
-  EXPECT_EQ(r.stats.n_cones, plain.stats.n_cones + r.stats.n_split_cones);
+  for (const int most : {2, 1}) {
+    ParamOptions split;
+    split.cone_split_distance = 1.5;  // model units: the spike is 8 high, its base of radius 1
+    split.cone_split_max_index = most;
+    const ParamResult r = compute_seamless_param(mesh, split);
+    const std::string name = "spike (split to " + std::to_string(most) + ")";
+    const Checked c = check_result(name, mesh, r);
+    EXPECT_EQ(c.cone_sum, 8) << name;
+    EXPECT_LE(max_index(r), most) << name;
+    EXPECT_GE(r.stats.n_split_cones, max_index(plain) - most) << name;
+    EXPECT_EQ(r.stats.n_cones, plain.stats.n_cones + r.stats.n_split_cones) << name;
+  }
 }
 
 TEST(SeamlessParam, TestDataMeshes) {

@@ -95,8 +95,8 @@ FeatureRun run_with_features(const core::TriMesh& mesh, int target, bool boundar
 }
 
 // A thin spike: the rounding gives its apex a cone of index 3 (a quad vertex of valence 1, which
-// extraction rejects); cone splitting (as the CLI does it, at one quad edge) spreads it into +1
-// cones, and the pipeline gives a valid pure-quad mesh of the spike.
+// extraction rejects); cone splitting as the CLI does it (one quad edge, index 2 kept) moves one
+// unit off it, and the pipeline gives a valid pure-quad mesh of the spike.
 TEST(QuantizeSeamless, ThinSpikeExtractsWithItsApexConeSplit) {
   expect_valid_quads("spike", test::spike(), 300, true);
 }

@@ -191,6 +191,12 @@ CommandRunner register_param(CLI::App& app) {
                  "far (model units) along the seams (0 = off, the paper)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--cone-split-max-index", o.cone_split_max_index,
+                 "With --cone-split-distance: cones of a larger index are split (2: index 3 and more, which no "
+                 "quad mesh can have; 1: also index 2, a flat quad corner, and +1 cones crowded within half "
+                 "the distance of another)")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   app.add_option("--cone-scale", o.cone_scale,
                  "Round the matchings on a copy of the mesh smoothed at this length (model units), so that "
                  "curvature details smaller than it make no cones, then lay out the mesh itself under "

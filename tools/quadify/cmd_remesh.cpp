@@ -493,6 +493,12 @@ CommandRunner register_remesh(CLI::App& app) {
                  "them; a cone of index 3 or more cannot be extracted)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--cone-split-max-index", args->param.cone_split_max_index,
+                 "With --cone-split-distance: cones of a larger index are split (2: index 3 and more, which no "
+                 "quad mesh can have; 1: also index 2, a flat quad corner, and +1 cones crowded within half "
+                 "the distance of another)")
+      ->check(CLI::Range(1, 2))
+      ->capture_default_str();
   app.add_option_function<std::string>(
          "--cone-scale",
          [args](const std::string& text) { args->cone_scale = text == "auto" ? -1 : std::stod(text); },

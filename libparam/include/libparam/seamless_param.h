@@ -63,12 +63,15 @@ struct ParamOptions {
   double cone_pair_distance = 0;
   int cone_pair_max_hops = 3;
   // Cone splitting (not in the paper; for quad meshing): after the cancellation, a cone of index
-  // 2 or more (UV angle π or less: a flat quad corner, or a quad vertex of valence 1 or 0; the
-  // rounding makes them at the tips of thin parts, such as octopus's tentacles) gives one unit of
-  // index at a time to a regular vertex whose path along the seams (≤ 64 edges, through regular
-  // vertices, off aligned features) is closest to this length (model units) and at most twice
-  // it, followed by the flip-free re-optimization of the cancellation. 0 = off (the paper).
+  // above cone_split_max_index (index 3: UV angle π/2, a quad vertex of valence 1, which no quad
+  // mesh has; index 2: a flat quad corner; the rounding makes them at the tips of thin parts,
+  // such as octopus's tentacles) gives one unit of index at a time to a regular vertex whose path
+  // along the seams (≤ 64 edges, through regular vertices, off aligned features) is closest to
+  // cone_split_distance (model units) and at most twice it, followed by the flip-free
+  // re-optimization of the cancellation. With cone_split_max_index 1, +1 cones closer than half
+  // the distance to another +1 cone move too. cone_split_distance 0 = off (the paper).
   double cone_split_distance = 0;
+  int cone_split_max_index = 2;
   // Coarse cones (not in the paper; for quad meshing at coarse densities): when > 0, the
   // matchings are rounded (Alg. 1, with the cone-pair cancellation) on a copy of the mesh
   // smoothed at this length (model units; one implicit cotangent-Laplacian heat step of time
