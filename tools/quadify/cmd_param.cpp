@@ -186,9 +186,9 @@ CommandRunner register_param(CLI::App& app) {
       ->check(CLI::Range(1, 10))
       ->capture_default_str();
   app.add_option("--cone-split-distance", o.cone_split_distance,
-                 "Split every cone of index 2 or more (a quad vertex of valence 2 or less, made at the tips of "
-                 "thin parts) into cones of index 1, moving one unit of index at a time to a vertex about this "
-                 "far (model units) along the seams (0 = off, the paper)")
+                 "Split every cone of index above --cone-split-max-index (a quad vertex of valence 1 or 2, made "
+                 "at the tips of thin parts), moving one unit of index at a time to a vertex about this far "
+                 "(model units) along the seams (0 = off, the paper)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--cone-split-max-index", o.cone_split_max_index,

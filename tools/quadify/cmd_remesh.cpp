@@ -487,10 +487,10 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--cone-split-distance", args->cone_split_distance,
-                 "Split every cone of index 2 or more (a quad vertex of valence 2 or less: the rounding makes "
-                 "them at the tips of thin parts, such as tentacles) into cones of index 1, one unit of index "
-                 "at a time moved to a vertex about this many quad edge lengths away along the seams (0 = keep "
-                 "them; a cone of index 3 or more cannot be extracted)")
+                 "Split every cone of index above --cone-split-max-index (index 3 is a quad vertex of valence "
+                 "1, which no quad mesh has: the rounding makes them at the tips of thin parts, such as "
+                 "tentacles), one unit of index at a time moved to a vertex about this many quad edge lengths "
+                 "away along the seams (0 = keep them; extraction then rejects such a map)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--cone-split-max-index", args->param.cone_split_max_index,
