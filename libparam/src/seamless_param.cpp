@@ -660,17 +660,16 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     out.stats.seconds_optimize += seconds_since(to);
   }
-  // Cone splitting: a cone of index 2 or more (a flat quad corner, or a quad vertex of valence
-  // 1 or less) gives one unit of index at a time to a regular vertex about
-  // cone_split_distance away along the seams.
+  // Cone splitting: a cone of index above cone_split_max_index (3: a quad vertex of valence 1;
+  // 2: a flat quad corner) gives one unit of index at a time to a regular vertex about
+  // cone_split_distance away along the seams (see find_cone_splits).
   if (options.cone_split_distance > 0 && out.status.is_ok()) {
     const auto to = Clock::now();
     move_failures = 0;
     for (int pass = 0; pass < kConeSplitPasses && move_failures < kMaxCancellationFailures; ++pass) {
       const std::vector<ConePairCancellation> splits =
           find_cone_splits(mesh, cut, vertex_indices(mesh, cut, x), options.cone_split_max_index,
-                           options.cone_split_distance,
-                           kConeSplitHops, feature_vertices);
+                           options.cone_split_distance, kConeSplitHops, feature_vertices);
       if (splits.empty()) break;
       const int n = apply_moves(splits, 0, splits.size(), max_isometric_distortion(domain, x));
       out.stats.n_split_cones += n;

@@ -160,7 +160,7 @@ struct ParamStats {
   int n_improved = 0;          // patches whose choice differs from the nearest rounding
   int n_batches = 0;           // rounding batches that rounded at least one matching
   int n_cancelled_pairs = 0;   // cone pairs removed by cone-pair cancellation
-  int n_split_cones = 0;       // units of index moved off cones of index ≥ 2 (cone splitting)
+  int n_split_cones = 0;       // units of index moved off cones by cone splitting
   int n_deferred_matchings = 0;  // seams whose rounding a batch deferred (flips near them)
   bool coarse_cones = false;   // the matchings were rounded on the smoothed copy (cone_scale)
   std::string coarse_cones_fallback_reason;  // why cone_scale was asked for but not used
