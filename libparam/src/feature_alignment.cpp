@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <unordered_map>
 
 namespace quadify::param {
 namespace {
@@ -65,6 +67,204 @@ SparseRow feature_row(const CutMesh& cut, int halfedge, int constant_coord) {
   else
     row.entries = {{vb, 1.0}, {va, -1.0}};
   return row;
+}
+
+double label_turn(double q, int label) {
+  double target = std::round(q);
+  if ((label == 0 || label == 1) && nearest_label(q) != label) target += q < target ? -1 : 1;
+  return (target - q) * (std::numbers::pi / 2);
+}
+
+namespace {
+
+// The mesh vertices of a feature's edge.
+std::array<int, 2> feature_vertices(const core::TriMesh& mesh, const FeatureSet& fs, int i) {
+  const int h = fs.halfedge[i];
+  return {mesh.F(h / 3, h % 3), mesh.F(h / 3, (h % 3 + 1) % 3)};
+}
+
+// UV angle of corner c in the layout x (positive when its face is not flipped).
+double corner_uv_angle(const CutMesh& cut, const Eigen::VectorXd& x, int c) {
+  const Eigen::Vector2d p = copy_uv(cut, x, c);
+  const Eigen::Vector2d a = copy_uv(cut, x, next_in_face(c)) - p;
+  const Eigen::Vector2d b = copy_uv(cut, x, prev_in_face(c)) - p;
+  return std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+}
+
+// Counter-clockwise UV angle around vertex v from edge ea to edge eb (both at v), or NaN when a
+// boundary lies in between or ea has no corner at v on its left.
+double fan_angle_ccw(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x, int v, int ea,
+                     int eb) {
+  const auto& topo = cut.topo;
+  int start = topo.edge_halfedge[ea];
+  if (mesh.F(start / 3, start % 3) != v) start = topo.twin[start];
+  if (start < 0) return std::numeric_limits<double>::quiet_NaN();
+  double total = 0;
+  int c = start;
+  for (int guard = 0; guard < 3 * mesh.n_faces(); ++guard) {
+    total += corner_uv_angle(cut, x, c);
+    const int hp = prev_in_face(c);
+    if (topo.face_edge(hp / 3, hp % 3) == eb) return total;
+    c = topo.twin[hp];
+    if (c < 0 || c == start) break;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
+                                                double max_bend) {
+  // The features at each vertex, with the other end of their edge.
+  std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());
+  for (int i = 0; i < fs.size(); ++i) {
+    const auto [a, b] = feature_vertices(mesh, fs, i);
+    at[a].push_back({i, b});
+    at[b].push_back({i, a});
+  }
+  // partner[i][end]: the feature continuing i at its vertex `end` (0: first, 1: second), or -1.
+  std::vector<std::array<int, 2>> partner(fs.size(), {-1, -1});
+  for (int v = 0; v < mesh.n_vertices(); ++v) {
+    const auto& list = at[v];
+    if (list.size() < 2) continue;
+    const Eigen::Vector3d p = mesh.V.row(v);
+    std::vector<int> other(list.size(), -1), n_straight(list.size(), 0);
+    for (size_t j = 0; j < list.size(); ++j)
+      for (size_t k = j + 1; k < list.size(); ++k) {
+        const Eigen::Vector3d a = Eigen::Vector3d(mesh.V.row(list[j].second)) - p;
+        const Eigen::Vector3d b = Eigen::Vector3d(mesh.V.row(list[k].second)) - p;
+        if (std::atan2(a.cross(b).norm(), a.dot(b)) < std::numbers::pi - max_bend) continue;
+        ++n_straight[j];
+        ++n_straight[k];
+        other[j] = static_cast<int>(k);
+        other[k] = static_cast<int>(j);
+      }
+    for (size_t j = 0; j < list.size(); ++j) {
+      const int k = other[j];
+      if (k < 0 || n_straight[j] != 1 || n_straight[k] != 1) continue;
+      const int i = list[j].first;
+      partner[i][feature_vertices(mesh, fs, i)[0] == v ? 0 : 1] = list[k].first;
+    }
+  }
+  // Walks: from the features with a free end first (open curves), then the loops left.
+  std::vector<FeatureCurve> curves;
+  std::vector<char> used(fs.size(), 0);
+  auto walk = [&](int first, int from_end) {
+    FeatureCurve curve;
+    int i = first, end = from_end;  // leave feature i through its vertex 1 − end
+    while (true) {
+      used[i] = 1;
+      curve.features.push_back(i);
+      const int v = feature_vertices(mesh, fs, i)[1 - end];
+      const int next = partner[i][1 - end];
+      if (next < 0) break;
+      curve.joints.push_back(v);
+      if (next == first) {
+        curve.closed = true;
+        break;
+      }
+      if (used[next]) break;
+      i = next;
+      end = feature_vertices(mesh, fs, i)[0] == v ? 0 : 1;
+    }
+    if (curve.features.size() >= 2) curves.push_back(std::move(curve));
+  };
+  for (int i = 0; i < fs.size(); ++i)
+    if (!used[i] && (partner[i][0] < 0 || partner[i][1] < 0)) walk(i, partner[i][0] < 0 ? 0 : 1);
+  for (int i = 0; i < fs.size(); ++i)
+    if (!used[i]) walk(i, 0);
+  return curves;
+}
+
+std::vector<double> curve_turns(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
+                                const FeatureSet& fs, const FeatureCurve& curve) {
+  const auto& topo = cut.topo;
+  const size_t n = curve.features.size();
+  std::vector<double> psi(n, 0);
+  auto edge_of = [&](int i) {
+    const int h = fs.halfedge[i];
+    return topo.face_edge(h / 3, h % 3);
+  };
+  for (size_t k = 0; k + 1 < n; ++k) {
+    const int v = curve.joints[k];
+    const int ea = edge_of(curve.features[k]), eb = edge_of(curve.features[k + 1]);
+    // θ: from the outgoing direction of the previous feature at v to that of the next; a straight
+    // continuation has θ = ±π, and the curve turns by θ ∓ π.
+    double theta = fan_angle_ccw(mesh, cut, x, v, ea, eb);
+    if (std::isnan(theta)) {
+      const double back = fan_angle_ccw(mesh, cut, x, v, eb, ea);
+      theta = std::isnan(back) ? back : -back;
+    }
+    psi[k + 1] = psi[k] + (theta > 0 ? theta - std::numbers::pi : theta + std::numbers::pi);
+  }
+  return psi;
+}
+
+CurveLabels label_curves(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
+                         const FeatureSet& fs, const std::vector<FeatureCurve>& curves,
+                         const std::vector<int>& label, double max_turn,
+                         const std::function<bool(double)>& take) {
+  CurveLabels out;
+  out.label.assign(fs.size(), kUnlabeled);
+  out.handled.assign(fs.size(), 0);
+  auto length = [&](int i) {
+    const auto [a, b] = feature_vertices(mesh, fs, i);
+    return (mesh.V.row(a) - mesh.V.row(b)).norm();
+  };
+  for (const FeatureCurve& curve : curves) {
+    const size_t n = curve.features.size();
+    bool any_unlabeled = false;
+    for (const int i : curve.features) any_unlabeled |= label[i] == kUnlabeled;
+    if (!any_unlabeled) continue;
+    const std::vector<double> psi = curve_turns(mesh, cut, x, fs, curve);
+    std::vector<double> q(n);
+    for (size_t k = 0; k < n; ++k) q[k] = feature_measure(cut, x, fs.halfedge[curve.features[k]]);
+    // The target direction: that of the longest labeled run's axis, else from the grid of the
+    // features' axes (their 4-fold mean), the one of least largest turn.
+    double target = std::numeric_limits<double>::quiet_NaN();
+    double held = 0;
+    std::unordered_map<long long, double> held_by;  // target in quarter turns → labeled length
+    Eigen::Vector2d fourfold = Eigen::Vector2d::Zero();
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (size_t k = 0; k < n; ++k) {
+      const int i = curve.features[k];
+      if (!std::isfinite(psi[k])) continue;
+      if (label[i] == 0 || label[i] == 1) {
+        const double t = psi[k] + label_turn(q[k], label[i]);
+        const long long key = std::llround(t / (std::numbers::pi / 2));
+        if ((held_by[key] += length(i)) > held) {
+          held = held_by[key];
+          target = t;
+        }
+      } else if (label[i] == kUnlabeled) {
+        const double g = 4 * (psi[k] - q[k] * std::numbers::pi / 2);
+        fourfold += length(i) * Eigen::Vector2d(std::cos(g), std::sin(g));
+        lo = std::min(lo, psi[k]);
+        hi = std::max(hi, psi[k]);
+      }
+    }
+    if (std::isnan(target)) {
+      if (!(lo <= hi)) continue;
+      const double quarter = std::numbers::pi / 2;
+      const double grid = std::atan2(fourfold.y(), fourfold.x()) / 4;
+      const double mid = (lo + hi) / 2;
+      target = grid + quarter * std::round((mid - grid) / quarter);
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const int i = curve.features[k];
+      if (label[i] != kUnlabeled || !std::isfinite(psi[k])) continue;
+      const double turn = target - psi[k];
+      if (!(std::abs(turn) < max_turn)) continue;
+      out.handled[i] = 1;
+      const long n_quarters = std::lround(q[k] + turn / (std::numbers::pi / 2));
+      const int l = n_quarters % 2 == 0 ? 1 : 0;
+      if (!take(std::abs(label_turn(q[k], l)) / (std::numbers::pi / 2))) continue;
+      out.label[i] = l;
+      out.taken.push_back(i);
+    }
+  }
+  std::sort(out.taken.begin(), out.taken.end());
+  return out;
 }
 
 double feature_rotation_angle(const CutMesh& cut, const Eigen::VectorXd& x, const FeatureSet& fs) {
@@ -130,12 +330,7 @@ WedgeResolution resolve_wedge_conflicts(const core::TriMesh& mesh, const CutMesh
   std::vector<double> measure(fs.size(), 0), delta(fs.size(), 0);
   // The turn that brings a labeled feature onto its axis: to the nearest quarter of its label's
   // parity (local estimation may have chosen the farther axis).
-  auto turn = [&](int i, int l) {
-    const double q = measure[i];
-    double target = std::round(q);
-    if ((l == 0 || l == 1) && nearest_label(q) != l) target += q < target ? -1 : 1;
-    return (target - q) * (std::numbers::pi / 2);
-  };
+  auto turn = [&](int i, int l) { return label_turn(measure[i], l); };
   for (int i = 0; i < fs.size(); ++i) {
     measure[i] = feature_measure(cut, x, fs.halfedge[i]);
     delta[i] = turn(i, label[i]);

@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <vector>
 
 namespace quadify::param {
@@ -36,6 +37,47 @@ inline int nearest_label(double measure) {
   const long n = std::lround(measure);
   return (n % 2 == 0) ? 1 : 0;
 }
+
+// Turn (radians) that brings an edge of measure q (quarter turns) onto the nearest direction
+// of label l's axis.
+double label_turn(double q, int label);
+
+// A smooth feature curve: features that continue each other on the surface (their angle at the
+// shared vertex within max_bend of 180°, each the other's only such partner at that vertex), in
+// order along the curve; joints[k] is the vertex shared by features[k] and features[k + 1]
+// (and, on a closed curve, joints.back() the one shared by the last and the first).
+struct FeatureCurve {
+  std::vector<int> features;
+  std::vector<int> joints;
+  bool closed = false;
+};
+// The smooth curves of two features or more (max_bend in radians), in order of first feature.
+std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
+                                                double max_bend);
+
+// Turn (radians, counter-clockwise positive) of each feature of a curve from the direction of its
+// first feature, followed along the curve in the layout x (corner angles summed around each
+// joint, so seams in between do not matter); the first is 0. NaN after a joint on a boundary
+// whose fan does not join the two features.
+std::vector<double> curve_turns(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
+                                const FeatureSet& fs, const FeatureCurve& curve);
+
+// One batch of whole-curve labels (ParamOptions::feature_curve_labels). Each curve with unlabeled
+// features is to become one straight iso-line: its target direction, followed along the curve
+// (curve_turns), is the axis its labeled features already have (the one of most labeled
+// length), else the axis direction that turns its unlabeled features least at most. A feature
+// whose turn to it stays below max_turn is handled by the curve (else it is labeled on its own):
+// its label is the one of that axis in its chart, and it is taken when take(|turn to that axis|
+// in quarter turns) holds.
+struct CurveLabels {
+  std::vector<int> label;     // per feature: the curve's label if taken, else kUnlabeled
+  std::vector<char> handled;  // per feature: handled by its curve (taken now or later)
+  std::vector<int> taken;     // features taken in this batch, increasing
+};
+CurveLabels label_curves(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
+                         const FeatureSet& fs, const std::vector<FeatureCurve>& curves,
+                         const std::vector<int>& label, double max_turn,
+                         const std::function<bool(double)>& take);
 
 // The alignment row x_b[c] − x_a[c] = 0 of a half-edge a→b keeping coordinate c constant.
 SparseRow feature_row(const CutMesh& cut, int halfedge, int constant_coord);

@@ -21,10 +21,13 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <climits>
 #include <functional>
 #include <iterator>
+#include <limits>
 #include <cmath>
 #include <mutex>
 #include <optional>
@@ -56,6 +59,12 @@ constexpr double kSoftStretchGrowth = 1.25;
 // A feature label whose patch exceeds feature_max_tau is kept when the patch without the label
 // reaches within this factor of it (the distortion comes from elsewhere).
 constexpr double kFeatureBlameGrowth = 1.1;
+// Whole-curve labels (ParamOptions::feature_curve_labels): consecutive features within this of
+// straight on the surface form a curve (radians), labeled as one unless its label would turn an
+// edge by this much or more (radians; below 90°, so that no two edges of the curve are sent to
+// opposite directions).
+constexpr double kCurveMaxBend = std::numbers::pi / 6;
+constexpr double kCurveMaxTurn = std::numbers::pi / 3;
 
 struct ComponentOutput {
   core::Status status;
@@ -173,6 +182,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       directions.size() > 0 ? direction_angle_mean(domain, directions, x) : 0;
   std::vector<int> label(fs.size(), kUnlabeled);
   std::vector<SparseRow> feature_rows;  // rows of the labeled features, in labeling order
+  // Smooth curves of two features or more, labeled as one (feature_curve_labels).
+  std::vector<FeatureCurve> curves;
+  if (options.feature_curve_labels && options.feature_mode == FeatureMode::kDuringRounding)
+    curves = smooth_feature_curves(mesh, fs, kCurveMaxBend);
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
 
@@ -287,14 +300,23 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     std::vector<int> fbatch;  // features labeled in this batch
     std::vector<double> fmeasure(fs.size(), 0);
+    auto take_error = [&](double err) {
+      return options.order == RoundingOrder::kBottomUp ? (last || err < eps) : (last || err > eps);
+    };
+    for (int i = 0; i < (soft_features ? 0 : fs.size()); ++i)
+      if (label[i] == kUnlabeled) fmeasure[i] = feature_measure(cut, x, fs.halfedge[i]);
+    // Whole curves (feature_curve_labels): their edges within kCurveMaxTurn of the curve's
+    // straight iso-line are labeled with it, when their turn to it is below the threshold.
+    const CurveLabels curve = label_curves(mesh, cut, x, fs, curves, label, kCurveMaxTurn,
+                                           [&](double turn) { return take_error(turn); });
+    const std::vector<int>& curve_label = curve.label;
+    const std::vector<char>& as_curve = curve.handled;
+    for (const int i : curve.taken) fbatch.push_back(i);
     for (int i = 0; i < (soft_features ? 0 : fs.size()); ++i) {
-      if (label[i] != kUnlabeled) continue;
-      fmeasure[i] = feature_measure(cut, x, fs.halfedge[i]);
-      const double err = std::abs(fmeasure[i] - std::round(fmeasure[i]));
-      const bool take = options.order == RoundingOrder::kBottomUp ? (last || err < eps)
-                                                                  : (last || err > eps);
-      if (take) fbatch.push_back(i);
+      if (label[i] != kUnlabeled || as_curve[i]) continue;
+      if (take_error(std::abs(fmeasure[i] - std::round(fmeasure[i])))) fbatch.push_back(i);
     }
+    std::sort(fbatch.begin(), fbatch.end());
     if (batch.empty() && fbatch.empty()) continue;
     // Local estimation of the uncertain ones (patches independent: parallel, deterministic).
     std::vector<int> chosen(batch.size());
@@ -334,6 +356,10 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       std::vector<int> uncertain_features;
       for (const int i : fbatch) {
         is_new[i] = 1;
+        if (curve_label[i] != kUnlabeled) {
+          proposed[i] = curve_label[i];
+          continue;
+        }
         proposed[i] = nearest_label(fmeasure[i]);
         if (options.local_estimation &&
             std::abs(fmeasure[i] - std::round(fmeasure[i])) >= options.local_estimation_min_error)

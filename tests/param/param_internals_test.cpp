@@ -540,5 +540,66 @@ TEST(FeatureAlignment, WedgeCheckGivesACornerFeatureNear45DegreesItsOtherAxis) {
   EXPECT_EQ(r.relabeled[0], 1);
 }
 
+// Sum of the 3D corner angles of `mesh` at vertex v (over all its faces).
+double angle_sum_3d(const core::TriMesh& mesh, int v) {
+  double sum = 0;
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) == v) {
+        const Eigen::Vector3d p = mesh.V.row(v);
+        const Eigen::Vector3d a = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 1) % 3))) - p;
+        const Eigen::Vector3d b = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 2) % 3))) - p;
+        sum += std::atan2(a.cross(b).norm(), a.dot(b));
+      }
+  return sum;
+}
+
+TEST(FeatureAlignment, SmoothCurvesAndTheirTurnsInTheLayout) {
+  // A disk's boundary (24 edges turning 15° each on the surface) and two opposite spokes of its
+  // centre (157° apart) are two smooth curves: a loop and a line through the centre. In the
+  // isometric layout the curve turns at each joint by π minus the corner angles swept there.
+  const core::TriMesh mesh = test::make_disk(4, 24);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  const Eigen::VectorXd x = flatten(isometric_unfold(mesh, cut));
+  std::vector<int> edges;
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    if (cut.topo.is_boundary_edge(e)) edges.push_back(e);
+  ASSERT_EQ(edges.size(), 24u);
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    for (int k = 0; k < 2; ++k)
+      if (cut.topo.edge_vertex(e, k) == 0 && (cut.topo.edge_vertex(e, 1 - k) == 1 || cut.topo.edge_vertex(e, 1 - k) == 13))
+        edges.push_back(e);
+  ASSERT_EQ(edges.size(), 26u);
+  const FeatureSet fs = make_feature_set(cut, edges);
+  const std::vector<FeatureCurve> curves = smooth_feature_curves(mesh, fs, std::numbers::pi / 6);
+  ASSERT_EQ(curves.size(), 2u);
+  const FeatureCurve& loop = curves[0].closed ? curves[0] : curves[1];
+  const FeatureCurve& line = curves[0].closed ? curves[1] : curves[0];
+  ASSERT_TRUE(loop.closed);
+  EXPECT_FALSE(line.closed);
+  EXPECT_EQ(loop.features.size(), 24u);
+  EXPECT_EQ(loop.joints.size(), 24u);
+  ASSERT_EQ(line.features.size(), 2u);
+  ASSERT_EQ(line.joints.size(), 1u);
+  EXPECT_EQ(line.joints[0], 0);
+  // Half the centre's fan lies on either side of the line.
+  const std::vector<double> psi_line = curve_turns(mesh, cut, x, fs, line);
+  EXPECT_NEAR(std::abs(psi_line[1]), std::numbers::pi - angle_sum_3d(mesh, 0) / 2, 1e-9);
+  // Along the loop, every joint turns the same way, by π minus the boundary vertex's angle sum.
+  const std::vector<double> psi = curve_turns(mesh, cut, x, fs, loop);
+  ASSERT_EQ(psi.size(), 24u);
+  for (size_t k = 0; k + 1 < psi.size(); ++k) {
+    const double turn = psi[k + 1] - psi[k];
+    EXPECT_NEAR(std::abs(turn), std::numbers::pi - angle_sum_3d(mesh, loop.joints[k]), 1e-9) << "joint " << k;
+    EXPECT_GT(turn * psi[1], 0) << "joint " << k;
+  }
+  // At 20° of allowed bend the spokes (23° from straight) are two curves of one edge: only the
+  // loop is left.
+  const std::vector<FeatureCurve> tighter = smooth_feature_curves(mesh, fs, 20 * std::numbers::pi / 180);
+  ASSERT_EQ(tighter.size(), 1u);
+  EXPECT_TRUE(tighter[0].closed);
+  EXPECT_EQ(tighter[0].features.size(), 24u);
+}
+
 }  // namespace
 }  // namespace quadify::param

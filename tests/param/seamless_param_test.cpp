@@ -310,6 +310,23 @@ TEST(FeatureAlignment, BoxEdgesAreAlignedAndCornersAreCones) {
   for (const ConeInfo& k : r.cones) EXPECT_EQ(k.index, 1);
 }
 
+// Whole-curve labels on the box: its twelve edges are straight curves, every edge aligned, the
+// corners +1 cones, the map an isometry as without them.
+TEST(FeatureAlignment, BoxEdgesLabeledAsWholeCurves) {
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("box.obj")));
+  ParamOptions o = fast_options();
+  o.feature_edges = sharp_edge_pairs(mesh, 40);
+  o.feature_curve_labels = true;
+  const ParamResult r = compute_seamless_param(mesh, o);
+  const Checked c = check_result("box curves", mesh, r);
+  EXPECT_EQ(c.cone_sum, 8);
+  EXPECT_EQ(r.stats.n_aligned_features, 72);
+  EXPECT_EQ(r.stats.n_disabled_features, 0);
+  EXPECT_LT(feature_misalignment(mesh, r), 1e-9);
+  EXPECT_LT(r.stats.tau, 1.001);
+  ASSERT_EQ(r.cones.size(), 8u);
+}
+
 // Alg. 3: the same box with the features labeled after the matchings and pulled in by a
 // penalty: aligned within the tolerance (not exactly), every box edge kept, flip-free; the box's
 // sides still become rectangles, so the corners are the eight +1 cones and τ stays near 1.

@@ -125,6 +125,12 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
                  "values avoid flat quad corners where creases meet almost straight")
       ->capture_default_str()
       ->check(CLI::Range(1.0, 100.0));
+  app.add_flag("--feature-curve-labels", a->curve_labels,
+               "Label the edges of a smooth feature curve (consecutive edges within 30 degrees of "
+               "straight) together, as one straight iso-line, instead of edge by edge (the paper's "
+               "Alg. 2), where a curve that bends in the layout switches axes, and loses edges, where "
+               "it is straight on the surface; experimental: it helps on some CAD parts (fandisk's "
+               "curved rims) and hurts on others");
 }
 
 
@@ -140,6 +146,7 @@ FeatureInput collect_feature_edges(const FeatureArgs& args, const std::string& i
   options->feature_mode = args.soft ? param::FeatureMode::kAfterRounding : param::FeatureMode::kDuringRounding;
   fi.soft = args.soft;
   options->feature_max_wedge_stretch = args.max_wedge_stretch;
+  options->feature_curve_labels = args.curve_labels;
   options->feature_edges.clear();
   if (args.angle_deg > 0) {
     core::CreaseOptions crease;

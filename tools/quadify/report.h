@@ -91,6 +91,7 @@ struct FeatureArgs {
   bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
   double max_tau = 2.5;      // --feature-max-tau
   double max_wedge_stretch = 1.8;  // --feature-max-wedge-stretch
+  bool curve_labels = false;  // --feature-curve-labels: smooth feature curves labeled as one
   bool soft = false;         // --feature-mode after: Alg. 3 (param::FeatureMode::kAfterRounding)
 };
 void add_feature_options(CLI::App& app, FeatureArgs* args);
