@@ -115,8 +115,8 @@ struct ParamOptions {
   // the batch threshold, the others are labeled edge by edge as in the paper. Edge by edge, a
   // curve that bends past 45° in the layout switches axes where it is straight on the surface,
   // and the wedge check disables the edges there (fandisk's curved rims at 5,000 quads:
-  // Hausdorff 0.0066 → 0.0028 with it). Off by default: over 15 meshes at 2,000, 5,000 and
-  // 10,000 quads it helps as often as it hurts (see the README's design notes).
+  // Hausdorff 0.0066 → 0.0028 with it). Off by default: over 11 meshes at 5,000 quads and 4 at 2,000 and
+  // 10,000, Hausdorff was worse in 10 runs of 16 (see the README's design notes).
   bool feature_curve_labels = false;
   FeatureMode feature_mode = FeatureMode::kDuringRounding;
   // Alg. 3: largest |Δ constant coordinate| / |edge| accepted for a soft-aligned feature (the
