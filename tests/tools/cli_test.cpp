@@ -374,6 +374,18 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   const CliRun off = quadify(args + " --no-feature-snap", dir_);
   ASSERT_EQ(off.exit_code, 0) << off.err;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["relax"]["snapped"], 0);
+  EXPECT_EQ(report["param"]["features"]["curve_labels"], false);
+  // The box's twelve edges are straight curves: labeled as whole curves they are all kept too.
+  std::string curve_args = args;
+  curve_args.append(" --feature-curve-labels");
+  const CliRun curves = quadify(curve_args, dir_);
+  ASSERT_EQ(curves.exit_code, 0) << curves.err;
+  const auto with_curves = nlohmann::json::parse(slurp(dir_ / "r.json"));
+  EXPECT_EQ(with_curves["param"]["features"]["curve_labels"], true);
+  EXPECT_EQ(with_curves["param"]["features"]["aligned"], 72);
+  EXPECT_GE(with_curves["quads"]["feature_capture"].get<double>(), 0.999);
+  EXPECT_EQ(with_curves["quads"]["flipped_quads"], 0);
+  EXPECT_EQ(with_curves["quads"]["non_quads"], 0);
 }
 
 // Creases that are all short (--min-crease-quads above the box's network, 72 edges in one

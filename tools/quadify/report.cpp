@@ -145,6 +145,7 @@ FeatureInput collect_feature_edges(const FeatureArgs& args, const std::string& i
   options->feature_max_tau = args.max_tau;
   options->feature_mode = args.soft ? param::FeatureMode::kAfterRounding : param::FeatureMode::kDuringRounding;
   fi.soft = args.soft;
+  fi.curve_labels = args.curve_labels;
   options->feature_max_wedge_stretch = args.max_wedge_stretch;
   options->feature_curve_labels = args.curve_labels;
   options->feature_edges.clear();
@@ -247,6 +248,7 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
 
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
   return {{"mode", fi.soft ? "after" : "during"},
+          {"curve_labels", fi.curve_labels},
           {"detected_sharp_edges", fi.n_detected},
           {"sharp_edges_not_creases", fi.n_not_creases},
           {"given_edges", fi.n_given},

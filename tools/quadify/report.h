@@ -110,6 +110,7 @@ struct FeatureInput {
   int n_stray_creases = 0;  // creases left out as an organic model's stray fragments (remesh only)
   int n_wedges_flipped = 0;  // core::flip_feature_wedges on the repaired mesh
   bool soft = false;    // Alg. 3 (--feature-mode after)
+  bool curve_labels = false;  // --feature-curve-labels
 };
 // Also flips the feature wedges of loaded->repaired.mesh (core::flip_feature_wedges: faces
 // change, vertex ids stay).
