@@ -257,7 +257,14 @@ std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, con
     sides.clear();
     for (const int e : chain) sides.push_back(side_angle(e));
     std::nth_element(sides.begin(), sides.begin() + sides.size() / 2, sides.end());
-    if (sides[sides.size() / 2] < options.max_side_angle_deg)
+    double lo = 180, hi = 0;
+    for (const int e : chain) {
+      lo = std::min(lo, dihedral[e]);
+      hi = std::max(hi, dihedral[e]);
+    }
+    const bool uniform = options.uniform_min_deg > 0 && static_cast<int>(chain.size()) >= options.uniform_min_edges &&
+                         lo >= options.uniform_min_deg && hi - lo <= options.uniform_spread_deg;
+    if (sides[sides.size() / 2] < options.max_side_angle_deg || uniform)
       for (const int e : chain) keep[e] = 1;
   }
   // Groups of sharp edges connected through vertices: a group made mostly of crease chains is

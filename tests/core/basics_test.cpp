@@ -231,6 +231,45 @@ TEST(TopologyTest, CreaseFilterLeavesOutTheSharpEdgesOfAnOrganicMesh) {
   EXPECT_TRUE(crease_edges(spot, topo, strict).empty()) << "no sharp edge of spot has flat sides";
 }
 
+// A closed prism of n sides (a coarsely faceted cylinder of radius 1 and height 1, capped by
+// fans): its two rims are rings of n edges at 90°, its sides meet at 360°/n.
+TriMesh capped_prism(int n) {
+  TriMesh m;
+  m.V.resize(2 + 2 * n, 3);
+  m.V.row(0) << 0, 0, 0;
+  m.V.row(1) << 0, 0, 1;
+  for (int j = 0; j < n; ++j) {
+    const double a = 2 * std::numbers::pi * j / n;
+    m.V.row(2 + j) << std::cos(a), std::sin(a), 0;
+    m.V.row(2 + n + j) << std::cos(a), std::sin(a), 1;
+  }
+  m.F.resize(4 * n, 3);
+  for (int j = 0; j < n; ++j) {
+    const int b0 = 2 + j, b1 = 2 + (j + 1) % n, t0 = b0 + n, t1 = b1 + n;
+    m.F.row(4 * j) << 0, b1, b0;
+    m.F.row(4 * j + 1) << 1, t0, t1;
+    m.F.row(4 * j + 2) << b0, b1, t1;
+    m.F.row(4 * j + 3) << b0, t1, t0;
+  }
+  return m;
+}
+
+TEST(TopologyTest, TheEvenRimsOfAFacetedCylinderAreCreases) {
+  // The rims' sides are curved (facets at 22.5°, above the 15° side angle), but every rim edge is
+  // at 90°: a machined edge, kept by the uniform-chain rule, and only by it.
+  const TriMesh prism = capped_prism(16);
+  const EdgeTopology topo = build_edge_topology(prism);
+  const std::vector<int> sharp = sharp_edges(prism, topo, 40);
+  ASSERT_EQ(sharp.size(), 32u);
+  EXPECT_EQ(crease_edges(prism, topo, CreaseOptions{}), sharp);
+  CreaseOptions no_uniform;
+  no_uniform.uniform_min_deg = 0;
+  EXPECT_TRUE(crease_edges(prism, topo, no_uniform).empty()) << "by the side angle alone, no crease";
+  CreaseOptions strict;
+  strict.uniform_min_deg = 95;  // the rims are at 90°
+  EXPECT_TRUE(crease_edges(prism, topo, strict).empty());
+}
+
 using test::folded_strips;
 
 TEST(TopologyTest, AShortKnifeEdgeIsACreaseAShortFoldIsNot) {
