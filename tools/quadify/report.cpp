@@ -95,7 +95,9 @@ void add_feature_options(CLI::App& app, FeatureArgs* a) {
                  "edges is dropped when the median, over its edges, of the largest dihedral angle of "
                  "the other edges of their faces is at least this (degrees), and so are groups of "
                  "fewer than 6 sharp edges unless their median dihedral angle is at least 120 degrees "
-                 "(a short knife edge, such as a blade's tip, stays); this leaves out the sharp edges of scans and sculpts "
+                 "(a short knife edge, such as a blade's tip, stays), and chains of 4 edges or more whose dihedral angles "
+                 "are all at least 60 degrees and within 5 degrees of each other stay too (a machined edge, such as "
+                 "a drilled hole's rim beside faceted walls); this leaves out the sharp edges of scans and sculpts "
                  "(coarsely tessellated tips, folds and crevices); 0 = every sharp edge")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 180.0));
