@@ -65,8 +65,8 @@ struct CreaseOptions {
   // A chain of at least uniform_min_edges edges whose dihedral angles are all at least
   // uniform_min_deg and within uniform_spread_deg of each other is a crease chain too, whatever
   // its sides: a machined edge such as a drilled hole's rim (90° all round) beside a coarsely
-  // faceted cylinder. Scan and sculpt creases are neither that sharp nor that even (none of the
-  // 26 organic benchmark meshes has such a chain). uniform_min_deg 0 turns this off.
+  // faceted cylinder. Scan and sculpt creases are not that even (of the 30 benchmark meshes only
+  // casting and crank have such chains). uniform_min_deg 0 turns this off.
   double uniform_min_deg = 60;
   double uniform_spread_deg = 5;
   int uniform_min_edges = 4;
