@@ -364,11 +364,8 @@ WedgeResolution resolve_wedge_conflicts(const core::TriMesh& mesh, const CutMesh
     bool closed = false;
     int c = start[v];
     for (int guard = 0; guard < 3 * mesh.n_faces(); ++guard) {
-      const Eigen::Vector2d p = copy_uv(cut, x, c);
-      const Eigen::Vector2d d_out = copy_uv(cut, x, next_in_face(c)) - p;
-      const Eigen::Vector2d d_in = copy_uv(cut, x, prev_in_face(c)) - p;
       fan.push_back({total, total3d, fs.edge_feature[topo.face_edge(c / 3, c % 3)]});
-      total += std::atan2(d_out.x() * d_in.y() - d_out.y() * d_in.x(), d_out.dot(d_in));
+      total += corner_uv_angle(cut, x, c);
       total3d += corner_angle3d(c);
       const int next = topo.twin[prev_in_face(c)];
       if (next < 0) {

@@ -307,8 +307,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       if (label[i] == kUnlabeled) fmeasure[i] = feature_measure(cut, x, fs.halfedge[i]);
     // Whole curves (feature_curve_labels): their edges within kCurveMaxTurn of the curve's
     // straight iso-line are labeled with it, when their turn to it is below the threshold.
-    const CurveLabels curve = label_curves(mesh, cut, x, fs, curves, label, kCurveMaxTurn,
-                                           [&](double turn) { return take_error(turn); });
+    const CurveLabels curve = label_curves(mesh, cut, x, fs, curves, label, kCurveMaxTurn, take_error);
     const std::vector<int>& curve_label = curve.label;
     const std::vector<char>& as_curve = curve.handled;
     for (const int i : curve.taken) fbatch.push_back(i);
