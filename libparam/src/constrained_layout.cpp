@@ -13,6 +13,8 @@
 #endif
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <array>
 #include <limits>
@@ -795,6 +797,27 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
       for (const auto& [v, a] : rows[i])
         el.M(i, std::lower_bound(el.ys.begin(), el.ys.end(), v) - el.ys.begin()) += a;
   });
+  // The elimination can couple many unknowns in one triangle (a map with very many cones: the
+  // loops around them are solved for translations, which then chain), and the Hessian's pattern
+  // grows with the square of that (options.max_element_entries). Refused with a clear error.
+  {
+    double entries = 0;
+    size_t widest = 0;
+    for (const Impl::Face& el : m.faces) {
+      entries += static_cast<double>(el.ys.size()) * static_cast<double>(el.ys.size());
+      widest = std::max(widest, el.ys.size());
+    }
+    if (entries > options.max_element_entries) {
+      char msg[400];
+      std::snprintf(msg, sizeof msg,
+                    "the seam constraints, eliminated, couple up to %zu unknowns in one triangle "
+                    "(%.3g Hessian entries, %.0f per triangle, above the limit of %.3g, about %.1f GB): "
+                    "the map has too many cones for this elimination",
+                    widest, entries, entries / std::max(nf, 1), options.max_element_entries,
+                    options.max_element_entries * 32 / 1e9);
+      return core::Status::numerical_failure(msg);
+    }
+  }
   // Hessian pattern, analysed once.
   std::vector<Eigen::Triplet<double>> trip;
   for (int i = 0; i < m.n(); ++i) trip.emplace_back(i, i, 0.0);

@@ -725,6 +725,17 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                                              " flipped or degenerate faces");
     return out;
   }
+  // A cone of index 3 or more (UV angle 90° or less) would be a quad vertex of valence 1 or 0:
+  // extraction refuses it, so no rounding is tried (octopus spent 150 s on such a map).
+  for (const param::ConeInfo& c : seamless.cones)
+    if (c.index >= 3) {
+      out.status = core::Status::invalid_input(
+          "cone vertex " + std::to_string(c.vertex) + " has index " + std::to_string(c.index) + " (UV angle " +
+          std::to_string(90 * (4 - c.index)) +
+          "°): no quad mesh has a vertex of valence " + std::to_string(4 - c.index) +
+          " (split such cones: param::ParamOptions::cone_split_distance)");
+      return out;
+    }
   // Cones and the gauge copy of each component.
   std::vector<char> is_cone_vertex(mesh.n_vertices(), 0);
   for (const param::ConeInfo& c : seamless.cones) {

@@ -101,6 +101,28 @@ TEST(QuantizeSeamless, ThinSpikeExtractsWithItsApexConeSplit) {
   expect_valid_quads("spike", test::spike(), 300, true);
 }
 
+// Without cone splitting the spike's apex keeps its index-3 cone: quantization refuses the map at
+// once (no rounding can make a quad vertex of valence 1) and names the cone.
+TEST(QuantizeSeamless, ConeOfIndexThreeIsRefusedBeforeRounding) {
+  const core::TriMesh mesh = test::spike();
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 300;
+  param::ParamOptions po;
+  po.energy = param::Energy::kSymmetricDirichlet;
+  const param::ParamResult map = param::compute_seamless_param(mesh, po);
+  ASSERT_TRUE(map.status.is_ok()) << map.status.to_string();
+  int apex_index = 0;
+  for (const param::ConeInfo& c : map.cones)
+    if (c.vertex == mesh.n_vertices() - 2) apex_index = c.index;
+  ASSERT_EQ(apex_index, 3) << "the spike's apex (see test::spike)";
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, map, qo);
+  EXPECT_EQ(q.status.code(), core::StatusCode::kInvalidInput);
+  EXPECT_NE(q.status.message().find("cone vertex " + std::to_string(mesh.n_vertices() - 2) + " has index 3"),
+            std::string::npos)
+      << q.status.message();
+  EXPECT_EQ(q.stats.n_rounded, 0);
+}
+
 TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {
   const core::TriMesh mesh = load("box.obj");
   const FeatureRun run = run_with_features(mesh, 200, false);
@@ -396,6 +418,24 @@ TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
     }
   }
   EXPECT_GT(n_checked, 0);
+}
+
+// The element Hessians' size is bounded: a layout whose elimination couples more than
+// max_element_entries (Σ over faces of its free unknowns²) is refused with the figures, not built.
+TEST(PinnedLayout, RefusesAnEliminationAboveTheEntryLimit) {
+  const core::TriMesh mesh = load("torus.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok());
+  param::CopyLayout cl;
+  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  param::PinnedLayoutOptions po;
+  param::PinnedLayout layout;
+  ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, po).is_ok()) << "the default limit";
+  // Every face depends on at least 2 free unknowns (4 entries): a limit below 4 per face fails.
+  po.max_element_entries = 3.0 * mesh.n_faces();
+  const core::Status st = layout.init(mesh, cl, 10 * cl.x, po);
+  EXPECT_EQ(st.code(), core::StatusCode::kNumericalFailure);
+  EXPECT_NE(st.message().find("unknowns in one triangle"), std::string::npos) << st.message();
 }
 
 // The sphere's seamless map at 10× scale in a PinnedLayout (for the PinnedLayout tests).

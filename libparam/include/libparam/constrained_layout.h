@@ -157,6 +157,12 @@ struct PinnedLayoutOptions {
   // across the UV axis it is nearest to in x0)²; the axis is fixed at init.
   std::vector<Eigen::Vector3d> face_direction;
   double direction_weight = 3;
+  // Limit on Σ over faces of (free variables the face depends on)², the size of the element
+  // Hessians (about 32 bytes each): init fails (kNumericalFailure, naming the figures) above it.
+  // A map with very many cones can couple thousands of unknowns per triangle after the
+  // elimination (linkCup's 1,481 cones: 8.9e8, which ran out of 24 GB); spot at 5,000 quads has
+  // 6.4e5.
+  double max_element_entries = 4e7;
 };
 
 // Outcome of PinnedLayout::pin: targets that were reached flip-free are pinned; the others stay
