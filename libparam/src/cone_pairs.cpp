@@ -1,6 +1,7 @@
 #include "cone_pairs.h"
 
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -164,9 +165,38 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
   }
   // Targets clear of the other positive cones (a cone that keeps some of its index counts).
   std::vector<ConePairCancellation> clear;
-  for (ConePairCancellation& c : candidates)
-    if (!near_positive(c.negative_vertex, index[c.positive_vertex] > 1 ? -1 : c.positive_vertex))
-      clear.push_back(std::move(c));
+  // A cone above max_index none of whose targets is clear (a tentacle's tip crowded with +1
+  // cones: octopus with thin-part sizing) takes the target farthest from the positive cones:
+  // no quad mesh has its index, a crowded +1 cone is only harder to place.
+  auto clearance = [&](int v, int skip) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const int q : positive)
+      if (q != skip) d = std::min(d, (mesh.V.row(q) - mesh.V.row(v)).norm());
+    return d;
+  };
+  std::vector<int> best_crowded(nv, -1);
+  std::vector<double> best_clearance(nv, -1);
+  std::vector<char> has_clear(nv, 0);
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const ConePairCancellation& c = candidates[i];
+    const int skip = index[c.positive_vertex] > 1 ? -1 : c.positive_vertex;
+    if (!near_positive(c.negative_vertex, skip)) {
+      has_clear[c.positive_vertex] = 1;
+    } else if (index[c.positive_vertex] > max_index) {
+      const double d = clearance(c.negative_vertex, skip);
+      if (d > best_clearance[c.positive_vertex]) {
+        best_clearance[c.positive_vertex] = d;
+        best_crowded[c.positive_vertex] = static_cast<int>(i);
+      }
+    }
+  }
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    const int p = candidates[i].positive_vertex;
+    const int skip = index[p] > 1 ? -1 : p;
+    if (!near_positive(candidates[i].negative_vertex, skip) ||
+        (!has_clear[p] && best_crowded[p] == static_cast<int>(i)))
+      clear.push_back(candidates[i]);
+  }
   auto miss = [distance](const ConePairCancellation& c) { return std::abs(c.path_length - distance); };
   std::sort(clear.begin(), clear.end(), [&](const auto& a, const auto& b) {
     return std::make_tuple(miss(a), a.positive_vertex, a.negative_vertex) <

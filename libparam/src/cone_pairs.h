@@ -60,7 +60,8 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
 // for each such interior cone p, a path of at most max_hops seam edges to a regular interior
 // vertex q, through regular interior vertices, whose 3D length is closest to `distance` (at
 // most 2·distance, or a single edge), with q at least distance/2 from every other positive cone
-// and from the other targets. Applying it moves one unit of index from p to q (q becomes a +1
+// and from the other targets (a cone above max_index with no such target takes the one farthest
+// from the positive cones). Applying it moves one unit of index from p to q (q becomes a +1
 // cone). One move per cone per call, paths disjoint; greedily by |length − distance| (ties by
 // vertex ids: deterministic). `avoid` as above. The result uses ConePairCancellation with
 // negative_vertex = the target q.
