@@ -586,13 +586,17 @@ class Extractor {
       return {-1, {}};
     }
     if (loc.where != Where::kVertex) return {-1, {}};
+    // Around a cone the walk comes back to f turned by the holonomy: at a cone of index 2 (UV
+    // angle π) the quarter turn left of an arriving iso-line lies in f itself, seen once around
+    // (octopus with thin-part sizing), so f is tried again after the full turn.
     const int c0 = 3 * f + loc.k;
     Transform acc;
     for (int c = c0;;) {
       const int next = cw_corner(c);
-      if (next < 0 || next == c0) break;
+      if (next < 0) break;
       acc = compose(trans_[c], acc);  // crossing the edge leaving the vertex in face(c)
       if (contains(next / 3, acc.apply(p), rot_dir(a, acc.r), rot_dir(b, acc.r))) return {next / 3, acc};
+      if (next == c0) break;
       c = next;
     }
     return {-1, {}};

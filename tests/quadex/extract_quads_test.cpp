@@ -453,6 +453,47 @@ TEST(ExtractQuads, OpenDiskConesHaveValenceThreeAndFive) {
   }
 }
 
+// Cones of index 2 (UV angle π: two quadrants) are quad vertices of valence 2: a tetrahedron
+// (4 cones of index 2) folded from the rectangle [0,8]×[0,4] whose bottom side is cut through
+// its midpoint M = (4,0) along the slanted segment X' = (3,2) → M → X = (5,−2) (glued to itself
+// by the half-turn about M), so that M's fan spans −63°…117° and one face, (M, P, Q), spans
+// −9°…99°. The iso-line v = 0 arrives at M inside that face, and its left turn (the quadrant
+// below +u, beyond the fan's end) lies in the same face seen once around the cone, turned by
+// the holonomy: that turn used to be missed, and the trace walked a boundary the closed fan does
+// not have (octopus with thin-part sizing: "boundary walk … does not terminate").
+TEST(ExtractQuads, ConesOfIndexTwoAreVerticesOfValenceTwo) {
+  // Vertices: 0 A≡B, 1 M, 2 N, 3 D≡C, 4 X≡X', 5 P, 6 Q.
+  const double net[10][3][2] = {{{4, 0}, {5, -2}, {7, -0.5}},  {{4, 0}, {7, -0.5}, {3.5, 3}},
+                                {{4, 0}, {3.5, 3}, {3, 2}},    {{5, -2}, {8, 0}, {7, -0.5}},
+                                {{7, -0.5}, {8, 0}, {8, 4}},   {{7, -0.5}, {8, 4}, {4, 4}},
+                                {{7, -0.5}, {4, 4}, {3.5, 3}}, {{3.5, 3}, {4, 4}, {0, 4}},
+                                {{3.5, 3}, {0, 4}, {3, 2}},    {{3, 2}, {0, 4}, {0, 0}}};
+  const int faces[10][3] = {{1, 4, 5}, {1, 5, 6}, {1, 6, 4}, {4, 0, 5}, {5, 0, 3},
+                            {5, 3, 2}, {5, 2, 6}, {6, 2, 3}, {6, 3, 4}, {4, 3, 0}};
+  for (unsigned seed = 0; seed < 6; ++seed) {
+    const std::string name = "folded tetrahedron, seed " + std::to_string(seed);
+    UVMesh tet;
+    tet.mesh.V.resize(7, 3);
+    tet.mesh.V << 1, 1, 1, 1, -1, -1, -1, 1, -1, -1, -1, 1, 1.2, -0.9, 0.2, 0.3, 0.2, -1.1, -0.8, 0.1, -0.2;
+    tet.mesh.F.resize(10, 3);
+    tet.corner_uv.resize(30, 2);
+    for (int f = 0; f < 10; ++f)
+      for (int k = 0; k < 3; ++k) {
+        tet.mesh.F(f, k) = faces[f][k];
+        tet.corner_uv.row(3 * f + k) << net[f][k][0], net[f][k][1];
+      }
+    if (seed > 0) scramble_charts(tet, seed);
+    const ExtractResult r = extract_quads(tet);
+    expect_all_quads(r, 32, name);
+    EXPECT_EQ(r.stats.n_cones, 4) << name;
+    PolyCheck c = check_poly(r.quads);
+    EXPECT_EQ(c.n_bad_edges, 0) << name;
+    EXPECT_EQ(c.n_boundary_edges, 0) << name;
+    EXPECT_EQ(c.euler, 2) << name;
+    EXPECT_EQ(c.valences[2], 4) << name;
+  }
+}
+
 // A hat of four triangles around an apex whose UV fan spans one quadrant, [0,2]², closed by a
 // 90° rotation: a cone of index 3, which would be a quad vertex of valence 1. Refused with a
 // message naming it (it used to fail later, in the tracing, as an internal error).
