@@ -128,6 +128,30 @@ std::vector<double> adaptive_face_size(const core::TriMesh& mesh, const Adaptive
   return face_size_from_vertices(mesh, vertex_size);
 }
 
+std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge_length,
+                                          const ThinPartSizingOptions& options) {
+  if (!(edge_length > 0) || !(options.max_edge_over_radius > 0) || !(options.min_ratio > 0) ||
+      !(options.min_ratio <= 1))
+    throw std::invalid_argument("thin_part_vertex_size: edge_length > 0, max_edge_over_radius > 0 "
+                                "and min_ratio in (0, 1] required");
+  const int nv = mesh.n_vertices();
+  const core::VertexCurvature curvature = core::estimate_curvature(mesh);
+  std::vector<double> log_size(nv, 0);
+  const double lo = std::log(options.min_ratio);
+  for (int v = 0; v < nv; ++v) {
+    // A tube of radius r has mean curvature 1/(2r); a saddle (where a tentacle leaves the body)
+    // has a small one, and is not thin.
+    const double radius = 1 / std::abs(curvature.k_max[v] + curvature.k_min[v]);
+    if (!(radius > 0) || !std::isfinite(radius)) continue;
+    // Relative length r · max_edge_over_radius / edge_length, clamped to [min_ratio, 1].
+    log_size[v] = std::clamp(std::log(options.max_edge_over_radius * radius / edge_length), lo, 0.0);
+  }
+  smooth(core::vertex_neighbours(mesh), options.smoothing_passes, &log_size);
+  std::vector<double> size(nv);
+  for (int v = 0; v < nv; ++v) size[v] = std::exp(log_size[v]);
+  return size;
+}
+
 std::vector<Eigen::Matrix3d> adaptive_face_metric(const core::TriMesh& mesh,
                                                   const AdaptiveSizingOptions& options) {
   const int nv = mesh.n_vertices(), nf = mesh.n_faces();

@@ -102,6 +102,43 @@ TEST(Sizing, AdaptiveSizesAreSmallerWhereTheSurfaceBendsMore) {
   for (const double s : adaptive_face_size(e, o)) EXPECT_NEAR(s, 1.0, 1e-12) << "ratio 1: uniform";
 }
 
+TEST(Sizing, ThinPartSizesShrinkWhereTheRadiusIsBelowAQuadEdge) {
+  // Ellipsoid (3, 1, 1): curvatures 1 and 1/9 at the equator (radius 1 / (1 + 1/9) = 0.9), 3 and
+  // 3 at the tips (radius 1/6).
+  const core::TriMesh e = ellipsoid(3);
+  // Quads of edge 0.1 fit everywhere: all ones.
+  for (const double s : thin_part_vertex_size(e, 0.1)) EXPECT_EQ(s, 1.0);
+  // Quads of edge 0.5: the tips are thinner than a quad, the equator is not.
+  ThinPartSizingOptions o;
+  const std::vector<double> vs = thin_part_vertex_size(e, 0.5, o);
+  int n_tip = 0, n_mid = 0;
+  for (int v = 0; v < e.n_vertices(); ++v) {
+    EXPECT_GE(vs[v], o.min_ratio - 1e-12) << v;
+    EXPECT_LE(vs[v], 1.0) << v;
+    if (std::abs(e.V(v, 0)) > 2.9) {
+      ++n_tip;
+      EXPECT_LT(vs[v], 0.85) << "tip " << v;  // (1/6) / 0.5 = 0.33 at the tip, smoothed over 30 passes
+    }
+    if (std::abs(e.V(v, 0)) < 0.5) {
+      ++n_mid;
+      EXPECT_GT(vs[v], 0.99) << "equator " << v;
+    }
+  }
+  EXPECT_GT(n_tip, 0);
+  EXPECT_GT(n_mid, 0);
+  // A smaller floor is reached with coarser quads; the normalized face sizes keep the count.
+  o.min_ratio = 0.5;
+  for (const double s : thin_part_vertex_size(e, 5.0, o)) EXPECT_GE(s, 0.5 - 1e-12);
+  const std::vector<double> fs = face_size_from_vertices(e, vs);
+  double area = 0, sized = 0;
+  for (int f = 0; f < e.n_faces(); ++f) {
+    area += face_area(e, f);
+    sized += face_area(e, f) / (fs[f] * fs[f]);
+  }
+  EXPECT_NEAR(sized, area, 1e-9 * area);
+  EXPECT_THROW((void)thin_part_vertex_size(e, 0.0), std::invalid_argument);
+}
+
 TEST(Sizing, AnisotropicMetricIsLongerAlongTheDirectionOfLesserCurvature) {
   const core::TriMesh e = ellipsoid(3);
   const std::vector<Eigen::Matrix3d> metric = adaptive_face_metric(e);

@@ -6,6 +6,7 @@
 #include <libcore/atomic_file.h>
 #include <libcore/write_mesh.h>
 #include <libparam/seamless_param.h>
+#include <libparam/sizing.h>
 #include <libquadex/extract_quads.h>
 #include <libquadex/quad_metrics.h>
 #include <libquadex/relax_quads.h>
@@ -31,6 +32,7 @@ struct RemeshArgs {
   bool relax = true;
   bool feature_snap = true;
   bool fit = true;
+  bool thin_parts = true;  // retry a dead end with thin-part sizing (param::thin_part_vertex_size)
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
@@ -61,6 +63,10 @@ constexpr double kFeatureTimeFactor = 3;
 // Automatic coarse cones (--cone-scale auto) that fail at quantize::kCoarseConeQuadEdges (e.g. a
 // cone of index 3 at a thin tip) are tried once more at this many times the smoothing length.
 constexpr double kCoarseRetryFactor = 1.4;
+
+// Thin-part sizing (after a dead end at every scale): vertices whose relative size falls below
+// this count as thin; the fallback runs only if there is one.
+constexpr double kThinSize = 0.95;
 
 // The same density request kRefineFactor times finer (more quads).
 void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {
@@ -154,7 +160,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       }
     }
   }
-  const SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
+  SizingInput sizing = apply_sizing_args(args.sizing, loaded, progress);
   sizing.apply_to(&param_options);
   quantize_options.face_size = sizing.face_size;
   quantize_options.face_metric = sizing.face_metric;
@@ -305,6 +311,47 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     coarsen();
     integer_map = quantize_map(seamless);
   }
+  // Thin parts: where the surface wraps a radius smaller than the quad edge (tentacles, fingers,
+  // horns), the cones at their tips find no grid points, and every scale dead-ends (octopus at
+  // 5,000 quads), or a tip keeps a cone of index 3 that cone splitting could not move. Without a
+  // size field of the user's, parametrize and quantize once more with quads as small as the local
+  // radius there (param::thin_part_vertex_size; the count stays).
+  const bool dead_end = (integer_map.status.code() == core::StatusCode::kNotConverged &&
+                         integer_map.status.message().find("time budget") == std::string::npos) ||
+                        (integer_map.status.code() == core::StatusCode::kInvalidInput &&
+                         integer_map.status.message().find(" has index ") != std::string::npos);
+  if (dead_end && args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty()) {
+    const std::vector<double> thin =
+        param::thin_part_vertex_size(mesh, quantize::target_edge_length(mesh, quantize_options));
+    double thin_area = 0, area = 0;
+    for (int f = 0; f < mesh.n_faces(); ++f) {
+      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                            p2 = mesh.V.row(mesh.F(f, 2));
+      const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+      area += a;
+      for (int k = 0; k < 3; ++k)
+        if (thin[mesh.F(f, k)] < kThinSize) thin_area += a / 3;
+    }
+    const double smallest = thin.empty() ? 1.0 : *std::min_element(thin.begin(), thin.end());
+    if (smallest < kThinSize) {
+      if (!common.quiet)
+        std::fprintf(stderr,
+                     "quadify: %s: no integer map (%s); %.0f%% of the surface is thinner than "
+                     "the quads (radius of curvature below a quad edge): parametrizing again with quads "
+                     "down to %.2f times as long there\n",
+                     args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
+      sizing.face_size = param::face_size_from_vertices(mesh, thin);
+      sizing.report = {{"mode", "thin-parts"},
+                       {"reason", integer_map.status.message()},
+                       {"min", number(smallest)},
+                       {"thin_area_share", number(thin_area / area)}};
+      sizing.apply_to(&param_options);
+      quantize_options.face_size = sizing.face_size;
+      seamless = parametrize(param_options);
+      coarsen();
+      integer_map = quantize_map(seamless);
+    }
+  }
   if (integer_map.status.is_ok() && integer_map.stats.n_released_feature_edges > 0 && !common.quiet)
     std::fprintf(stderr,
                  "quadify: %s: %d aligned feature edges near dead ends of the rounding were released "
@@ -313,7 +360,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   if (!integer_map.status.is_ok())
     throw CliError{kExitInternal,
                    args.input + ": quantization failed: " + integer_map.status.to_string() +
-                       (integer_map.status.message().find("time budget") == std::string::npos
+                       (integer_map.status.code() == core::StatusCode::kNotConverged &&
+                                integer_map.status.message().find("time budget") == std::string::npos
                             ? " (a larger --target-faces often helps)"
                             : "")};
 
@@ -527,6 +575,11 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str()
       ->type_name("SECONDS");
+  app.add_flag("!--no-thin-parts", args->thin_parts,
+               "Do not retry a quantization that dead-ends with smaller quads where the surface is thinner "
+               "than a quad (by default, without --adaptive or --size-field: quads down to a quarter of "
+               "the target edge where the radius of curvature is below it, the count kept; sizing.mode "
+               "\"thin-parts\" in the report)");
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "

@@ -27,6 +27,29 @@ struct AdaptiveSizingOptions {
 [[nodiscard]] std::vector<double> adaptive_face_size(const core::TriMesh& mesh,
                                                      const AdaptiveSizingOptions& options = {});
 
+// Thin-part sizing: where the surface curves around a radius smaller than the quad edge (a
+// tentacle, a finger, a horn's tip), a grid of that edge cannot wrap it, and the cones its tip
+// needs have no grid points to sit on (octopus at 5,000 quads). The relative edge length there is
+// the local radius r = 1 / |κ1 + κ2| (a tube's radius from its mean curvature; a saddle, where a
+// tentacle leaves the body, is not thin) over the quad edge, times max_edge_over_radius: a tube
+// of radius r gets about 2π / max_edge_over_radius quads around.
+struct ThinPartSizingOptions {
+  // Quad edge over the local radius of curvature where that would be smaller than the target
+  // edge: 1 gives a tube about six quads around.
+  double max_edge_over_radius = 1;
+  // Smallest relative edge length (elsewhere 1).
+  double min_ratio = 0.25;
+  // Passes of averaging log sizes with the neighbours' (as adaptive_face_size).
+  int smoothing_passes = 30;
+};
+
+// Per-vertex relative edge lengths in [min_ratio, 1] for quads of edge `edge_length` (model
+// units): 1 wherever the surface is not thinner than that (pass them to face_size_from_vertices,
+// which normalizes them so the quad count of a target stays). All ones when the surface has no
+// such part.
+[[nodiscard]] std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge_length,
+                                                        const ThinPartSizingOptions& options = {});
+
 // Curvature-adaptive anisotropic sizing: per face a metric (param::ParamOptions::face_metric)
 // asking for edge length ∝ 1/sqrt(|κ|) along each principal direction (longer quads along the
 // direction in which the surface bends less, e.g. along a cylinder's axis), each length clamped
