@@ -386,12 +386,20 @@ TEST(QuantizeSeamless, ClusteredConesTakeDistinctGridPoints) {
 
 // The lattice property the rounding relies on: with cone copies preferred free, every cone
 // coordinate and seam translation is an integer combination of free integer unknowns.
-TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
-  const core::TriMesh mesh = load("torus.obj");
-  const param::ParamResult p = param::compute_seamless_param(mesh);
-  ASSERT_TRUE(p.status.is_ok());
+// The torus's seamless map and its copies (for the PinnedLayout tests).
+struct TorusCopies {
+  core::TriMesh mesh = load("torus.obj");
+  param::ParamResult p = param::compute_seamless_param(mesh);
   param::CopyLayout cl;
-  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  bool ok = p.status.is_ok() && param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok();
+};
+
+TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
+  const TorusCopies torus;
+  ASSERT_TRUE(torus.ok);
+  const core::TriMesh& mesh = torus.mesh;
+  const param::ParamResult& p = torus.p;
+  const param::CopyLayout& cl = torus.cl;
   std::vector<char> cone_vertex(mesh.n_vertices(), 0), cone_copy(cl.n_copies(), 0);
   for (const param::ConeInfo& c : p.cones) cone_vertex[c.vertex] = 1;
   for (int k = 0; k < cl.n_copies(); ++k) cone_copy[k] = cone_vertex[cl.copy_vertex[k]];
@@ -423,11 +431,10 @@ TEST(PinnedLayout, CandidatesAreIntegerCombinationsOfFreeIntegerUnknowns) {
 // The element Hessians' size is bounded: a layout whose elimination couples more than
 // max_element_entries (Σ over faces of its free unknowns²) is refused with the figures, not built.
 TEST(PinnedLayout, RefusesAnEliminationAboveTheEntryLimit) {
-  const core::TriMesh mesh = load("torus.obj");
-  const param::ParamResult p = param::compute_seamless_param(mesh);
-  ASSERT_TRUE(p.status.is_ok());
-  param::CopyLayout cl;
-  ASSERT_TRUE(param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  const TorusCopies torus;
+  ASSERT_TRUE(torus.ok);
+  const core::TriMesh& mesh = torus.mesh;
+  const param::CopyLayout& cl = torus.cl;
   param::PinnedLayoutOptions po;
   param::PinnedLayout layout;
   ASSERT_TRUE(layout.init(mesh, cl, 10 * cl.x, po).is_ok()) << "the default limit";
