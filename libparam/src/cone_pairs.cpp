@@ -174,28 +174,21 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
       if (q != skip) d = std::min(d, (mesh.V.row(q) - mesh.V.row(v)).norm());
     return d;
   };
-  std::vector<int> best_crowded(nv, -1);
-  std::vector<double> best_clearance(nv, -1);
+  std::vector<double> room(candidates.size());
+  std::vector<int> roomiest(nv, -1);  // per cone above max_index: its crowded target farthest out
   std::vector<char> has_clear(nv, 0);
   for (size_t i = 0; i < candidates.size(); ++i) {
-    const ConePairCancellation& c = candidates[i];
-    const int skip = index[c.positive_vertex] > 1 ? -1 : c.positive_vertex;
-    if (!near_positive(c.negative_vertex, skip)) {
-      has_clear[c.positive_vertex] = 1;
-    } else if (index[c.positive_vertex] > max_index) {
-      const double d = clearance(c.negative_vertex, skip);
-      if (d > best_clearance[c.positive_vertex]) {
-        best_clearance[c.positive_vertex] = d;
-        best_crowded[c.positive_vertex] = static_cast<int>(i);
-      }
-    }
+    const int p = candidates[i].positive_vertex;
+    room[i] = clearance(candidates[i].negative_vertex, index[p] > 1 ? -1 : p);
+    if (room[i] >= crowd)
+      has_clear[p] = 1;
+    else if (index[p] > max_index && (roomiest[p] < 0 || room[i] > room[roomiest[p]]))
+      roomiest[p] = static_cast<int>(i);
   }
   for (size_t i = 0; i < candidates.size(); ++i) {
     const int p = candidates[i].positive_vertex;
-    const int skip = index[p] > 1 ? -1 : p;
-    if (!near_positive(candidates[i].negative_vertex, skip) ||
-        (!has_clear[p] && best_crowded[p] == static_cast<int>(i)))
-      clear.push_back(candidates[i]);
+    if (room[i] >= crowd || (!has_clear[p] && roomiest[p] == static_cast<int>(i)))
+      clear.push_back(std::move(candidates[i]));
   }
   auto miss = [distance](const ConePairCancellation& c) { return std::abs(c.path_length - distance); };
   std::sort(clear.begin(), clear.end(), [&](const auto& a, const auto& b) {

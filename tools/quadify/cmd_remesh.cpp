@@ -318,8 +318,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // radius there (param::thin_part_vertex_size; the count stays).
   const bool dead_end = (integer_map.status.code() == core::StatusCode::kNotConverged &&
                          integer_map.status.message().find("time budget") == std::string::npos) ||
-                        (integer_map.status.code() == core::StatusCode::kInvalidInput &&
-                         integer_map.status.message().find(" has index ") != std::string::npos);
+                        std::any_of(seamless.cones.begin(), seamless.cones.end(),
+                                    [](const param::ConeInfo& c) { return c.index >= 3; });
   if (dead_end && args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty()) {
     const std::vector<double> thin =
         param::thin_part_vertex_size(mesh, quantize::target_edge_length(mesh, quantize_options));
