@@ -241,6 +241,8 @@ class Rounder {
   const std::string& stuck_reason() const { return stuck_; }
   // Whether the dead end came while rounding the cones (which go first in either order).
   bool stuck_on_cones() const { return stuck_on_cones_; }
+  // The mesh vertex of the cone the run dead-ended on (-1: not on a cone).
+  int stuck_cone_vertex() const { return stuck_cone_vertex_; }
   // Mesh faces that resist the move of the unknown the run dead-ended on
   // (param::PinnedLayout::limiting_faces, for both neighbouring integers or grid points).
   const std::vector<int>& stuck_faces() const { return stuck_faces_; }
@@ -456,6 +458,7 @@ class Rounder {
       if (!placed) {
         const Eigen::Vector2d p = position(c);
         stuck_on_cones_ = true;
+        stuck_cone_vertex_ = cl_.copy_vertex[c.copy];
         for (size_t a = 0; a < std::min(choices.size(), size_t{2}); ++a) {
           std::vector<std::pair<int, double>> t;
           if (!layout_.is_pinned(c.col_u)) t.push_back({c.col_u, choices[a].x()});
@@ -623,6 +626,7 @@ class Rounder {
     stuck_faces_.clear();
     stuck_.clear();
     stuck_on_cones_ = false;
+    stuck_cone_vertex_ = -1;
     return status_.is_ok();
   }
 
@@ -652,6 +656,7 @@ class Rounder {
   int n_pinned_ = 0;
   std::string stuck_;
   bool stuck_on_cones_ = false;
+  int stuck_cone_vertex_ = -1;
   std::vector<int> stuck_faces_;
 };
 
@@ -997,6 +1002,22 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       if (with_features && rounder.stuck_on_cones() && attempt + 1 < static_cast<int>(attempts.size()) &&
           attempts[attempt + 1].with_features && attempts[attempt + 1].scale == scale)
         ++attempt;
+      if (!with_features && options.continue_after_dead_end && attempt + 1 < static_cast<int>(attempts.size())) {
+        DeadEnd de;
+        de.attempt = attempt + 1;
+        for (int a = 0; a <= attempt; ++a) de.attempts_without_features += !attempts[a].with_features;
+        de.scale = scale / scales[0];
+        de.cone_vertex = rounder.stuck_cone_vertex();
+        de.faces = rounder.stuck_faces();
+        de.reason = last_stuck;
+        if (!options.continue_after_dead_end(de)) {
+          st.stopped_at_dead_end = true;
+          failure = core::Status::not_converged(
+              "no flip-free integer-seamless map: stopped after " + std::to_string(attempt + 1) + " of " +
+              std::to_string(attempts.size()) + " attempts at a dead end (" + last_stuck + ")");
+          break;
+        }
+      }
       continue;
     }
     Eigen::VectorXd xe;
@@ -1020,7 +1041,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     break;
   }
   if (!best) {
-    st.features_dropped = !feature_rows.empty() && failure.is_ok() && !last_stuck.empty();
+    st.features_dropped =
+        !feature_rows.empty() && (failure.is_ok() || st.stopped_at_dead_end) && !last_stuck.empty();
     out.status = failure.is_ok()
                      ? core::Status::not_converged(
                            "no flip-free integer-seamless map within " +

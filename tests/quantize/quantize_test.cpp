@@ -341,6 +341,42 @@ TEST(QuantizeSeamless, TimeBudgetStopsWithAMessage) {
             core::StatusCode::kInvalidInput);
 }
 
+// The caller's say at a dead end: a sphere's eight cones on a grid of two quads cannot all find
+// grid points, so the attempts dead-end; continue_after_dead_end sees each dead end before the
+// next scale (the cone and the faces in the way) and can stop the quantization there.
+TEST(QuantizeSeamless, CallerCanStopAtADeadEnd) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 2;
+  std::vector<quantize::DeadEnd> seen;
+  qo.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
+    seen.push_back(de);
+    return seen.size() < 3;
+  };
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
+  ASSERT_EQ(q.status.code(), core::StatusCode::kNotConverged) << q.status.to_string();
+  EXPECT_TRUE(q.stats.stopped_at_dead_end);
+  ASSERT_EQ(seen.size(), 3u) << "asked at each dead end until it said stop";
+  EXPECT_NE(q.status.message().find("stopped after 3 of"), std::string::npos) << q.status.message();
+  EXPECT_NE(q.status.message().find(seen[2].reason), std::string::npos) << q.status.message();
+  for (size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_EQ(seen[i].attempt, static_cast<int>(i) + 1);
+    EXPECT_EQ(seen[i].attempts_without_features, static_cast<int>(i) + 1) << "the map has no features";
+    EXPECT_FALSE(seen[i].reason.empty());
+    EXPECT_FALSE(seen[i].faces.empty()) << "the faces in the way";
+    if (seen[i].cone_vertex >= 0) {
+      EXPECT_LT(seen[i].cone_vertex, mesh.n_vertices());
+      EXPECT_NE(seen[i].reason.find("cone vertex " + std::to_string(seen[i].cone_vertex)), std::string::npos)
+          << seen[i].reason;
+    }
+  }
+  EXPECT_EQ(seen[0].scale, 1.0);
+  EXPECT_NE(seen[1].scale, 1.0) << "the next attempt is at another scale";
+  EXPECT_NE(seen[2].scale, seen[1].scale);
+}
+
 TEST(QuantizeSeamless, ProgressReportsRoundedUnknownsAndScale) {
   const core::TriMesh mesh = load("torus.obj");
   const param::ParamResult p = param::compute_seamless_param(mesh);

@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 
 namespace quadify::cli {
 namespace {
@@ -67,6 +68,11 @@ constexpr double kCoarseRetryFactor = 1.4;
 // Thin-part sizing (after a dead end at every scale): vertices whose relative size falls below
 // this count as thin; the fallback runs only if there is one.
 constexpr double kThinSize = 0.95;
+// A cone that dead-ends at two scales where the surface's radius is below this many quad edges
+// (thin-part size) stops the quantization there: more scales of the same map rarely help there,
+// and the thin-part retry does (octopus: 8 scales, 204 s, all dead-ending at tentacle tips).
+constexpr double kThinDeadEndSize = 0.5;
+constexpr int kThinDeadEndAttempts = 2;
 
 // The same density request kRefineFactor times finer (more quads).
 void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {
@@ -290,6 +296,19 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   coarsen();
   quantize_options.feature_time_budget_seconds =
       std::max(kMinFeatureSeconds, kFeatureTimeFactor * seamless.stats.seconds_total);
+  // Thin parts (see the retry below): the field, computed at the first dead end that needs it.
+  const bool thin_retry_allowed = args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty();
+  std::vector<double> thin;
+  auto thin_field = [&]() -> const std::vector<double>& {
+    if (thin.empty())
+      thin = param::thin_part_vertex_size(mesh, quantize::target_edge_length(mesh, quantize_options));
+    return thin;
+  };
+  if (thin_retry_allowed)
+    quantize_options.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
+      if (de.attempts_without_features < kThinDeadEndAttempts || de.cone_vertex < 0) return true;
+      return !(thin_field()[de.cone_vertex] < kThinDeadEndSize);
+    };
   quantize::QuantizeResult integer_map = quantize_map(seamless);
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
@@ -311,6 +330,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     coarsen();
     integer_map = quantize_map(seamless);
   }
+  quantize_options.continue_after_dead_end = nullptr;
   // Thin parts: where the surface wraps a radius smaller than the quad edge (tentacles, fingers,
   // horns), the cones at their tips find no grid points, and every scale dead-ends (octopus at
   // 5,000 quads), or a tip keeps a cone of index 3 that cone splitting could not move. Without a
@@ -320,9 +340,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                          integer_map.status.message().find("time budget") == std::string::npos) ||
                         std::any_of(seamless.cones.begin(), seamless.cones.end(),
                                     [](const param::ConeInfo& c) { return c.index >= 3; });
-  if (dead_end && args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty()) {
-    const std::vector<double> thin =
-        param::thin_part_vertex_size(mesh, quantize::target_edge_length(mesh, quantize_options));
+  if (dead_end && thin_retry_allowed) {
+    thin_field();
     double thin_area = 0, area = 0;
     for (int f = 0; f < mesh.n_faces(); ++f) {
       const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
@@ -345,11 +364,33 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
                        {"thin_area_share", number(thin_area / area)}};
+      // A quantization stopped early at a thin dead end resumes its other scales if the retry
+      // fails too.
+      const bool stopped_early = integer_map.stats.stopped_at_dead_end;
+      std::optional<param::ParamResult> stopped_map;
+      const SizingInput sizing_before = sizing;
+      const param::ParamOptions param_options_before = param_options;
+      const int fine_cones_before = fine_cones;
+      if (stopped_early) stopped_map = seamless;
       sizing.apply_to(&param_options);
       quantize_options.face_size = sizing.face_size;
       seamless = parametrize(param_options);
       coarsen();
       integer_map = quantize_map(seamless);
+      if (!integer_map.status.is_ok() && stopped_map) {
+        if (!common.quiet)
+          std::fprintf(stderr,
+                       "quadify: %s: no integer map with thin-part sizing either (%s); back to the "
+                       "first map, at its other scales\n",
+                       args.input.c_str(), integer_map.status.message().c_str());
+        sizing = sizing_before;
+        param_options = param_options_before;
+        quantize_options.face_size = sizing.face_size;
+        seamless = std::move(*stopped_map);
+        fine_cones = fine_cones_before;
+        report["param"] = param_json(seamless);
+        integer_map = quantize_map(seamless);
+      }
     }
   }
   if (integer_map.status.is_ok() && integer_map.stats.n_released_feature_edges > 0 && !common.quiet)

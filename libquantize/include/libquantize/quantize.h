@@ -14,6 +14,16 @@
 
 namespace quadify::quantize {
 
+// A dead end of the rounding (QuantizeOptions::continue_after_dead_end).
+struct DeadEnd {
+  int attempt = 0;         // attempts made so far (this one included), with and without features
+  int attempts_without_features = 0;  // of those, without aligned features
+  double scale = 1;        // this attempt's scale / the target scale
+  int cone_vertex = -1;    // mesh vertex of the cone that reached no grid point, or -1
+  std::vector<int> faces;  // mesh faces that resisted the blocked move
+  std::string reason;
+};
+
 struct QuantizeOptions {
   // Number of quads wanted: each unit square of the scaled map is one quad, so the map is scaled
   // to a UV area of target_faces. 0: use edge_length; if both are 0 the default target is
@@ -74,7 +84,13 @@ struct QuantizeOptions {
   // Optional progress callback, once per batch: stage "quantize x<scale factor> cones" or
   // "... translations", step = integer unknowns rounded so far of n_steps independent ones.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
+  // Optional: asked after an attempt without aligned features dead-ends, before the next scale
+  // is tried; false stops there (kNotConverged naming the dead end; stats.stopped_at_dead_end).
+  // A caller that has a better next step than more scales for some dead ends uses it (the
+  // remesher: a cone stuck in a part thinner than the quads, see DeadEnd).
+  std::function<bool(const DeadEnd&)> continue_after_dead_end;
 };
+
 
 struct QuantizeStats {
   double scale = 0;         // final factor from the input UVs to the integer map's UVs
@@ -100,6 +116,8 @@ struct QuantizeStats {
   int n_released_feature_edges = 0;
   bool features_dropped = false;
   std::string features_dropped_reason;  // why the rounding with the features dead-ended
+  // The rounding stopped at a dead end because continue_after_dead_end said so.
+  bool stopped_at_dead_end = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
   int n_iterations = 0;       // Newton iterations (one factorization each) in total
