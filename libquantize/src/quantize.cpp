@@ -993,6 +993,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                     options.time_budget_seconds, scale / scales[0], attempt + 1, attempts.size(),
                     rounder.n_pinned(), rounder.n_integer_columns());
       failure = core::Status::not_converged(msg);
+      st.out_of_time = true;
       break;
     }
     if (outcome == Rounder::Outcome::kStuck) {

@@ -336,6 +336,8 @@ TEST(QuantizeSeamless, TimeBudgetStopsWithAMessage) {
   EXPECT_EQ(q.status.code(), core::StatusCode::kNotConverged) << q.status.to_string();
   EXPECT_NE(q.status.message().find("time budget"), std::string::npos) << q.status.message();
   EXPECT_NE(q.status.message().find("scale"), std::string::npos) << q.status.message();
+  EXPECT_TRUE(q.stats.out_of_time);
+  EXPECT_FALSE(q.stats.stopped_at_dead_end);
   qo.time_budget_seconds = -1;
   EXPECT_EQ(quantize::quantize_seamless(mesh, p, qo).status.code(),
             core::StatusCode::kInvalidInput);
@@ -358,6 +360,7 @@ TEST(QuantizeSeamless, CallerCanStopAtADeadEnd) {
   const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
   ASSERT_EQ(q.status.code(), core::StatusCode::kNotConverged) << q.status.to_string();
   EXPECT_TRUE(q.stats.stopped_at_dead_end);
+  EXPECT_FALSE(q.stats.out_of_time);
   ASSERT_EQ(seen.size(), 3u) << "asked at each dead end until it said stop";
   EXPECT_NE(q.status.message().find("stopped after 3 of"), std::string::npos) << q.status.message();
   EXPECT_NE(q.status.message().find(seen[2].reason), std::string::npos) << q.status.message();

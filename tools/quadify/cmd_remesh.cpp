@@ -337,7 +337,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // size field of the user's, parametrize and quantize once more with quads as small as the local
   // radius there (param::thin_part_vertex_size; the count stays).
   const bool dead_end = (integer_map.status.code() == core::StatusCode::kNotConverged &&
-                         integer_map.status.message().find("time budget") == std::string::npos) ||
+                         !integer_map.stats.out_of_time) ||
                         std::any_of(seamless.cones.begin(), seamless.cones.end(),
                                     [](const param::ConeInfo& c) { return c.index >= 3; });
   if (dead_end && thin_retry_allowed) {
@@ -402,7 +402,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     throw CliError{kExitInternal,
                    args.input + ": quantization failed: " + integer_map.status.to_string() +
                        (integer_map.status.code() == core::StatusCode::kNotConverged &&
-                                integer_map.status.message().find("time budget") == std::string::npos
+                                !integer_map.stats.out_of_time
                             ? " (a larger --target-faces often helps)"
                             : "")};
 

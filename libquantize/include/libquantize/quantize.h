@@ -118,6 +118,8 @@ struct QuantizeStats {
   std::string features_dropped_reason;  // why the rounding with the features dead-ended
   // The rounding stopped at a dead end because continue_after_dead_end said so.
   bool stopped_at_dead_end = false;
+  // The quantization stopped at QuantizeOptions::time_budget_seconds (kNotConverged).
+  bool out_of_time = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
   int n_iterations = 0;       // Newton iterations (one factorization each) in total
