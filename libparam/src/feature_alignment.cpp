@@ -114,7 +114,7 @@ double fan_angle_ccw(const core::TriMesh& mesh, const CutMesh& cut, const Eigen:
 }  // namespace
 
 std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
-                                                double max_bend) {
+                                                double max_bend, double corner_length, double corner_turn) {
   // The features at each vertex, with the other end of their edge.
   std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());
   for (int i = 0; i < fs.size(); ++i) {
@@ -173,7 +173,79 @@ std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const
     if (!used[i] && (partner[i][0] < 0 || partner[i][1] < 0)) walk(i, partner[i][0] < 0 ? 0 : 1);
   for (int i = 0; i < fs.size(); ++i)
     if (!used[i]) walk(i, 0);
-  return curves;
+  if (!(corner_length > 0)) return curves;
+  // Corners of the quad scale: a curve that turns by corner_turn or more within corner_length is
+  // split at the joint of largest bend there.
+  std::vector<FeatureCurve> split;
+  for (FeatureCurve& curve : curves) {
+    const size_t nj = curve.joints.size();
+    auto length = [&](size_t k) {
+      const auto [a, b] = feature_vertices(mesh, fs, curve.features[k]);
+      return (mesh.V.row(a) - mesh.V.row(b)).norm();
+    };
+    // Arc position and bend of each joint (joint k between features k and k + 1 mod n).
+    std::vector<double> pos(nj), bend(nj);
+    double s = 0;
+    for (size_t k = 0; k < nj; ++k) {
+      s += length(k);
+      pos[k] = s;
+      const int v = curve.joints[k];
+      const auto other = [&](int i) {
+        const auto [a, b] = feature_vertices(mesh, fs, i);
+        return Eigen::Vector3d(mesh.V.row(a == v ? b : a) - mesh.V.row(v));
+      };
+      const Eigen::Vector3d a = other(curve.features[k]);
+      const Eigen::Vector3d b = other(curve.features[(k + 1) % curve.features.size()]);
+      bend[k] = std::numbers::pi - std::atan2(a.cross(b).norm(), a.dot(b));
+    }
+    const double total = s;  // a closed curve's joints include the last one
+    auto distance = [&](size_t j, size_t k) {
+      const double d = std::abs(pos[j] - pos[k]);
+      return curve.closed ? std::min(d, total - d) : d;
+    };
+    // The turn within `reach` of joint k.
+    auto turn_within = [&](size_t k, double reach) {
+      double turn = 0;
+      for (size_t j = 0; j < nj; ++j)
+        if (distance(j, k) <= reach) turn += bend[j];
+      return turn;
+    };
+    // The corner is the joint whose turn within a quarter of corner_length is largest among the
+    // joints within half of it (the middle of a rounded corner; ties to the first joint).
+    std::vector<double> score(nj);
+    for (size_t k = 0; k < nj; ++k) score[k] = turn_within(k, corner_length / 4);
+    std::vector<size_t> corners;
+    for (size_t k = 0; k < nj; ++k) {
+      if (!(turn_within(k, corner_length / 2) >= corner_turn)) continue;
+      bool largest = true;
+      for (size_t j = 0; j < nj && largest; ++j)
+        if (j != k && distance(j, k) <= corner_length / 2 &&
+            (score[j] > score[k] || (score[j] == score[k] && j < k)))
+          largest = false;
+      if (largest) corners.push_back(k);
+    }
+    if (corners.empty()) {
+      split.push_back(std::move(curve));
+      continue;
+    }
+    // Pieces between consecutive corners (a closed curve starts after its first corner).
+    const size_t n = curve.features.size();
+    std::vector<char> is_corner(nj, 0);
+    for (const size_t k : corners) is_corner[k] = 1;
+    const size_t first = curve.closed ? (corners.front() + 1) % n : 0;
+    FeatureCurve piece;
+    for (size_t t = 0; t < n; ++t) {
+      const size_t k = (first + t) % n;
+      piece.features.push_back(curve.features[k]);
+      if (t + 1 == n || (k < nj && is_corner[k])) {
+        if (piece.features.size() >= 2) split.push_back(std::move(piece));
+        piece = FeatureCurve{};
+      } else {
+        piece.joints.push_back(curve.joints[k]);
+      }
+    }
+  }
+  return split;
 }
 
 std::vector<double> curve_turns(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,

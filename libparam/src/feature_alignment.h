@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <numbers>
 #include <vector>
 
 namespace quadify::param {
@@ -52,8 +53,12 @@ struct FeatureCurve {
   bool closed = false;
 };
 // The smooth curves of two features or more (max_bend in radians), in order of first feature.
+// With corner_length > 0, a curve that turns by corner_turn (radians) or more within an arc of
+// corner_length (a rounded corner at the scale of the quads) is split at the joint of largest
+// bend there.
 std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
-                                                double max_bend);
+                                                double max_bend, double corner_length = 0,
+                                                double corner_turn = std::numbers::pi / 3);
 
 // Turn (radians, counter-clockwise positive) of each feature of a curve from the direction of its
 // first feature, followed along the curve in the layout x (corner angles summed around each

@@ -185,7 +185,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   // Smooth curves of two features or more, labeled as one (feature_curve_labels).
   std::vector<FeatureCurve> curves;
   if (options.feature_curve_labels && options.feature_mode == FeatureMode::kDuringRounding)
-    curves = smooth_feature_curves(mesh, fs, kCurveMaxBend);
+    curves = smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length);
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
 
@@ -897,6 +897,8 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   if (!(o.cone_scale >= 0) || !std::isfinite(o.cone_scale))
     return core::Status::invalid_input("cone_scale must be finite and >= 0");
   if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
+  if (!(o.feature_corner_length >= 0) || !std::isfinite(o.feature_corner_length))
+    return core::Status::invalid_input("feature_corner_length must be finite and >= 0");
   if (!(o.feature_max_tau > 1) || !(o.feature_max_wedge_stretch >= 1))
     return core::Status::invalid_input("feature_max_tau must be > 1 and feature_max_wedge_stretch >= 1");
   if (mesh.n_faces() == 0) return core::Status::invalid_input("mesh has no faces");

@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <climits>
 #include <cmath>
 #include <map>
@@ -599,6 +600,70 @@ TEST(FeatureAlignment, SmoothCurvesAndTheirTurnsInTheLayout) {
   ASSERT_EQ(tighter.size(), 1u);
   EXPECT_TRUE(tighter[0].closed);
   EXPECT_EQ(tighter[0].features.size(), 24u);
+}
+
+// A rounded square (sides of four unit edges, corners rounded by three edges of 0.2 turning
+// 22.5° at each of four joints), fanned from its centre: its boundary is one smooth loop. With a
+// corner length of one unit, each rounded corner (90° within 0.6) splits it, at the middle of the
+// rounding; with a length below the rounding's joints' spacing the loop stays whole.
+TEST(FeatureAlignment, RoundedCornersSplitSmoothCurves) {
+  core::TriMesh mesh;
+  std::vector<Eigen::Vector2d> ring;
+  Eigen::Vector2d p(0, 0);
+  double heading = 0;
+  std::vector<std::array<int, 2>> fillet_middle;  // the two middle joints of each rounding
+  for (int side = 0; side < 4; ++side) {
+    for (int k = 0; k < 4; ++k) {
+      ring.push_back(p);
+      p += Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    }
+    for (int k = 0; k < 3; ++k) {
+      ring.push_back(p);
+      if (k == 2) fillet_middle.push_back({static_cast<int>(ring.size()) - 2, static_cast<int>(ring.size()) - 1});
+      heading += std::numbers::pi / 8;
+      p += 0.2 * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+    }
+    heading = std::round(heading / (std::numbers::pi / 2)) * (std::numbers::pi / 2);
+  }
+  const int n = static_cast<int>(ring.size());
+  ASSERT_EQ(n, 28);
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const auto& q : ring) centre += q / n;
+  mesh.V.resize(n + 1, 3);
+  for (int i = 0; i < n; ++i) mesh.V.row(i) << ring[i].x(), ring[i].y(), 0;
+  mesh.V.row(n) << centre.x(), centre.y(), 0;
+  mesh.F.resize(n, 3);
+  for (int i = 0; i < n; ++i) mesh.F.row(i) << i, (i + 1) % n, n;
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  std::vector<int> edges;
+  for (int e = 0; e < cut.topo.n_edges(); ++e)
+    if (cut.topo.is_boundary_edge(e)) edges.push_back(e);
+  ASSERT_EQ(edges.size(), 28u);
+  const FeatureSet fs = make_feature_set(cut, edges);
+  const std::vector<FeatureCurve> whole = smooth_feature_curves(mesh, fs, std::numbers::pi / 6);
+  ASSERT_EQ(whole.size(), 1u);
+  EXPECT_TRUE(whole[0].closed);
+  EXPECT_EQ(smooth_feature_curves(mesh, fs, std::numbers::pi / 6, 0.1).size(), 1u)
+      << "no joint turns 60° within 0.1";
+  const std::vector<FeatureCurve> pieces = smooth_feature_curves(mesh, fs, std::numbers::pi / 6, 1.0);
+  ASSERT_EQ(pieces.size(), 4u);
+  size_t n_features = 0;
+  std::vector<char> joint(n, 0);
+  for (const FeatureCurve& c : pieces) {
+    EXPECT_FALSE(c.closed);
+    EXPECT_EQ(c.joints.size() + 1, c.features.size());
+    n_features += c.features.size();
+    for (const int v : c.joints) joint[v] = 1;
+  }
+  EXPECT_EQ(n_features, 28u) << "every edge in one piece";
+  // The split vertices (no piece's joint): one per rounding, at one of its two middle joints.
+  std::vector<int> roundings;
+  for (int v = 0; v < n; ++v) {
+    if (joint[v]) continue;
+    for (int r = 0; r < 4; ++r)
+      if (v == fillet_middle[r][0] || v == fillet_middle[r][1]) roundings.push_back(r);
+  }
+  EXPECT_EQ(roundings, (std::vector<int>{0, 1, 2, 3})) << "split at the middle of each rounding";
 }
 
 }  // namespace

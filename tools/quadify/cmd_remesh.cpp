@@ -68,6 +68,9 @@ constexpr double kCoarseRetryFactor = 1.4;
 // Thin-part sizing (after a dead end at every scale): vertices whose relative size falls below
 // this count as thin; the fallback runs only if there is one.
 constexpr double kThinSize = 0.95;
+// Whole-curve feature labels (--feature-curve-labels) split a smooth curve where it turns by 60°
+// or more within this many target quad edges (param::ParamOptions::feature_corner_length).
+constexpr double kFeatureCornerQuadEdges = 2;
 // A cone that dead-ends at two scales where the surface's radius is below this many quad edges
 // (thin-part size) stops the quantization there: more scales of the same map rarely help there,
 // and the thin-part retry does (octopus: 8 scales, 204 s, all dead-ending at tentacle tips).
@@ -137,6 +140,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   param_options.cone_pair_distance =
       quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
+  param_options.feature_corner_length = kFeatureCornerQuadEdges * quantize::target_edge_length(mesh, quantize_options);
   param_options.cone_split_distance =
       std::max(0.0, args.cone_split_distance) * quantize::target_edge_length(mesh, quantize_options);
   param_options.cone_scale = std::max(0.0, args.cone_scale) * quantize::target_edge_length(mesh, quantize_options);

@@ -118,6 +118,10 @@ struct ParamOptions {
   // Hausdorff 0.0066 → 0.0028 with it). Off by default: over 11 meshes at 5,000 quads and 4 at 2,000 and
   // 10,000, Hausdorff was worse in 10 runs of 16 (see the README's design notes).
   bool feature_curve_labels = false;
+  // With feature_curve_labels: a smooth curve that turns by 60° or more within this arc length
+  // (model units; a rounded corner at the scale of the quads: the remesher passes one target quad
+  // edge) is split there, at its joint of largest bend, into curves labeled on their own. 0 = off.
+  double feature_corner_length = 0;
   FeatureMode feature_mode = FeatureMode::kDuringRounding;
   // Alg. 3: largest |Δ constant coordinate| / |edge| accepted for a soft-aligned feature (the
   // paper reports at most 1e-5).
