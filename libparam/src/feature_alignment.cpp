@@ -175,7 +175,7 @@ std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const
     if (!used[i]) walk(i, 0);
   if (!(corner_length > 0)) return curves;
   // Corners of the quad scale: a curve that turns by corner_turn or more within corner_length is
-  // split at the joint of largest bend there.
+  // split there (see below which joint).
   std::vector<FeatureCurve> split;
   for (FeatureCurve& curve : curves) {
     const size_t nj = curve.joints.size();

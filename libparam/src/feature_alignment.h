@@ -54,8 +54,8 @@ struct FeatureCurve {
 };
 // The smooth curves of two features or more (max_bend in radians), in order of first feature.
 // With corner_length > 0, a curve that turns by corner_turn (radians) or more within an arc of
-// corner_length (a rounded corner at the scale of the quads) is split at the joint of largest
-// bend there.
+// corner_length (a rounded corner at the scale of the quads) is split there, at the joint whose
+// turn within corner_length / 4 is largest (the middle of the rounding).
 std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
                                                 double max_bend, double corner_length = 0,
                                                 double corner_turn = std::numbers::pi / 3);

@@ -65,7 +65,7 @@ constexpr double kFeatureTimeFactor = 3;
 // cone of index 3 at a thin tip) are tried once more at this many times the smoothing length.
 constexpr double kCoarseRetryFactor = 1.4;
 
-// Thin-part sizing (after a dead end at every scale): vertices whose relative size falls below
+// Thin-part sizing (after a dead end at every scale, or an early stop below): vertices whose relative size falls below
 // this count as thin; the fallback runs only if there is one.
 constexpr double kThinSize = 0.95;
 // Whole-curve feature labels (--feature-curve-labels) split a smooth curve where it turns by 60°
@@ -140,10 +140,10 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   param_options.cone_pair_distance =
       quantize::recommended_cone_pair_distance(mesh, quantize_options, args.cone_pair_distance);
   param_options.cone_pair_max_hops = quantize::kRecommendedConePairHops;
-  param_options.feature_corner_length = kFeatureCornerQuadEdges * quantize::target_edge_length(mesh, quantize_options);
-  param_options.cone_split_distance =
-      std::max(0.0, args.cone_split_distance) * quantize::target_edge_length(mesh, quantize_options);
-  param_options.cone_scale = std::max(0.0, args.cone_scale) * quantize::target_edge_length(mesh, quantize_options);
+  const double quad_edge = quantize::target_edge_length(mesh, quantize_options);
+  param_options.feature_corner_length = kFeatureCornerQuadEdges * quad_edge;
+  param_options.cone_split_distance = std::max(0.0, args.cone_split_distance) * quad_edge;
+  param_options.cone_scale = std::max(0.0, args.cone_scale) * quad_edge;
   param_options.threads = common.threads;
   param_options.progress = on_progress;
   FeatureInput feature_input = apply_feature_args(args.features, args.input, &loaded, &param_options);
@@ -292,7 +292,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       coarse_reason = coarse.stats.coarse_cones_fallback_reason;
       if (!common.quiet)
         std::fprintf(stderr, "quadify: %s: coarse cones at %.2g quad edges not used (%s)%s\n", args.input.c_str(),
-                     coarse_options.cone_scale / quantize::target_edge_length(mesh, quantize_options),
+                     coarse_options.cone_scale / quad_edge,
                      coarse_reason.c_str(),
                      attempt == 0 ? "; trying a smoother copy" : "; keeping the map's cones");
     }
@@ -304,8 +304,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   const bool thin_retry_allowed = args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty();
   std::vector<double> thin;
   auto thin_field = [&]() -> const std::vector<double>& {
-    if (thin.empty())
-      thin = param::thin_part_vertex_size(mesh, quantize::target_edge_length(mesh, quantize_options));
+    if (thin.empty()) thin = param::thin_part_vertex_size(mesh, quad_edge);
     return thin;
   };
   if (thin_retry_allowed)
@@ -370,12 +369,11 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"thin_area_share", number(thin_area / area)}};
       // A quantization stopped early at a thin dead end resumes its other scales if the retry
       // fails too.
-      const bool stopped_early = integer_map.stats.stopped_at_dead_end;
       std::optional<param::ParamResult> stopped_map;
+      if (integer_map.stats.stopped_at_dead_end) stopped_map = seamless;
       const SizingInput sizing_before = sizing;
       const param::ParamOptions param_options_before = param_options;
       const int fine_cones_before = fine_cones;
-      if (stopped_early) stopped_map = seamless;
       sizing.apply_to(&param_options);
       quantize_options.face_size = sizing.face_size;
       seamless = parametrize(param_options);

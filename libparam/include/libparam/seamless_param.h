@@ -119,8 +119,8 @@ struct ParamOptions {
   // 10,000, Hausdorff was worse in 10 runs of 16 (see the README's design notes).
   bool feature_curve_labels = false;
   // With feature_curve_labels: a smooth curve that turns by 60° or more within this arc length
-  // (model units; a rounded corner at the scale of the quads: the remesher passes one target quad
-  // edge) is split there, at its joint of largest bend, into curves labeled on their own. 0 = off.
+  // (model units; a rounded corner at the scale of the quads: the remesher passes two target quad
+  // edges) is split there, at the middle of the rounding, into curves labeled on their own. 0 = off.
   double feature_corner_length = 0;
   FeatureMode feature_mode = FeatureMode::kDuringRounding;
   // Alg. 3: largest |Δ constant coordinate| / |edge| accepted for a soft-aligned feature (the

@@ -91,7 +91,6 @@ struct QuantizeOptions {
   std::function<bool(const DeadEnd&)> continue_after_dead_end;
 };
 
-
 struct QuantizeStats {
   double scale = 0;         // final factor from the input UVs to the integer map's UVs
   int n_scale_retries = 0;  // restarts at another scale (near ones first, then refinements)
