@@ -21,6 +21,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <random>
 
 #include "test_meshes.h"
 
@@ -337,6 +338,44 @@ TEST(DistortionEnergy, DerivativesMatchFiniteDifferences) {
   }
   EXPECT_NEAR(evaluate_density(Density::kSymmetricDirichlet, 1, Eigen::Matrix2d::Identity(), false, false).value, 4, 1e-15);
   EXPECT_FALSE(evaluate_density(Density::kSymmetricDirichlet, 1, Eigen::Vector2d(1, -1).asDiagonal().toDenseMatrix(), false, false).finite);
+}
+
+// The analytic projection of symmetric Dirichlet's Hessians (and of their powers) equals the
+// eigensolver's clamp of the exact Hessian, on stretched, squashed, near-isometric and
+// near-conformal Jacobians.
+TEST(DistortionEnergy, AnalyticProjectionMatchesTheEigensolver) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Eigen::Matrix2d> jacobians = {Eigen::Matrix2d::Identity(),
+                                            0.5 * Eigen::Matrix2d::Identity(),
+                                            (Eigen::Matrix2d() << 0, -2, 2, 0).finished(),
+                                            (Eigen::Matrix2d() << 3, 0, 0, 0.2).finished()};
+  for (int k = 0; k < 200; ++k) {
+    Eigen::Matrix2d J;
+    J << unit(rng), unit(rng), unit(rng), unit(rng);
+    J *= std::exp(1.5 * unit(rng));
+    if (J.determinant() < 0) J.col(0) *= -1;
+    jacobians.push_back(J);
+  }
+  int indefinite = 0;
+  for (const Eigen::Matrix2d& J : jacobians) {
+    if (!(J.determinant() > 1e-6 * J.squaredNorm())) continue;
+    for (const auto& [kind, p] : {std::pair{Density::kSymmetricDirichlet, 1.0}, std::pair{Density::kPowerSD, 4.0},
+                                  std::pair{Density::kPowerSD, 64.0}}) {
+      const DensityEval exact = evaluate_density(kind, p, J, true, false);
+      if (!exact.hessian.allFinite()) continue;  // (ψ/4)^64 overflows on the most distorted
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> es(exact.hessian);
+      indefinite += es.eigenvalues().minCoeff() < 0;
+      const Eigen::Matrix4d reference =
+          es.eigenvectors() * es.eigenvalues().cwiseMax(0.0).asDiagonal() * es.eigenvectors().transpose();
+      const DensityEval projected = evaluate_density(kind, p, J, true, true);
+      EXPECT_EQ(projected.value, exact.value);
+      EXPECT_EQ(projected.gradient, exact.gradient);
+      EXPECT_LE((projected.hessian - reference).norm(), 1e-9 * (1 + reference.norm()))
+          << "kind " << int(kind) << " p " << p << " J\n" << J;
+    }
+  }
+  EXPECT_GT(indefinite, 100) << "the cases must exercise the clamp";
 }
 
 // The isometric unfold of m moved into the constraints of its nearest-integer matchings.
