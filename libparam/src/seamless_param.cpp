@@ -781,6 +781,14 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     red_problem.reset();
     out.stats.seconds_optimize += seconds_since(to);
   }
+  if (options.energy == Energy::kTau && tau_continuation && options.continue_before_tau && out.status.is_ok()) {
+    const std::vector<int> index = vertex_indices(mesh, cut, x);
+    const int n_cones = static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; }));
+    if (!options.continue_before_tau(n_cones)) {
+      tau_continuation = false;
+      out.stats.stopped_before_tau = true;
+    }
+  }
   if (options.energy == Energy::kTau && tau_continuation) {
     const auto to = Clock::now();
     if (penalty_rows) {
@@ -961,6 +969,7 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
       !(options.align_boundaries && core::topology_stats(mesh).n_boundary_loops > 0)) {
     ParamOptions fine_options = options;
     fine_options.cone_scale = 0;
+    fine_options.continue_before_tau = nullptr;
     core::TriMesh smoothed;
     core::Status s = smooth_for_cones(mesh, options.cone_scale, &smoothed);
     if (s.is_ok()) {
@@ -1058,6 +1067,7 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
   std::vector<ComponentOutput> outs(n_comp);
   // Components may run on worker threads: serialize the progress callback.
   ParamOptions component_options = options;
+  if (n_comp > 1) component_options.continue_before_tau = nullptr;
   std::mutex progress_mutex;
   if (options.progress)
     component_options.progress = [&](const std::string& stage, int step, int n_steps) {
@@ -1111,6 +1121,7 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
       result.features.push_back({sub_faces[c][fa.face], fa.corner, fa.constant_coord});
     st.n_feature_edges += o.stats.n_feature_edges;
     st.n_feature_fallbacks += fell_back[c];
+    st.stopped_before_tau = st.stopped_before_tau || o.stats.stopped_before_tau;
     if (fell_back[c] && st.feature_fallback_reason.empty())
       st.feature_fallback_reason = o.stats.feature_fallback_reason;
     st.n_aligned_features += o.stats.n_aligned_features;

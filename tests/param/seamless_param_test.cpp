@@ -107,6 +107,49 @@ TEST(SeamlessParam, TauEnergyReportsTau) {
   EXPECT_LT(r.stats.tau, 3.0) << "τ of a subdivided icosahedron should be moderate";
 }
 
+// A caller that only needs the cones stops before τ's continuation: asked once with the cone
+// count of the full run, the map is seamless and flip-free with the same cones and matchings,
+// and its τ is not below the continued map's. With two components it is not asked.
+TEST(SeamlessParam, CallerCanStopBeforeTheTauContinuation) {
+  const core::TriMesh mesh = test::make_icosphere(2);
+  const ParamResult full = compute_seamless_param(mesh, fast_options(Energy::kTau));
+  ParamOptions o = fast_options(Energy::kTau);
+  std::vector<int> asked;
+  o.continue_before_tau = [&](int n_cones) {
+    asked.push_back(n_cones);
+    return false;
+  };
+  const ParamResult stopped = compute_seamless_param(mesh, o);
+  check_result("icosphere2/stopped", mesh, stopped);
+  ASSERT_EQ(asked.size(), 1u);
+  EXPECT_EQ(asked[0], full.stats.n_cones);
+  EXPECT_TRUE(stopped.stats.stopped_before_tau);
+  EXPECT_FALSE(full.stats.stopped_before_tau);
+  EXPECT_EQ(stopped.stats.n_cones, full.stats.n_cones);
+  ASSERT_EQ(stopped.seams.size(), full.seams.size());
+  for (size_t i = 0; i < full.seams.size(); ++i) EXPECT_EQ(stopped.seams[i].matching, full.seams[i].matching);
+  EXPECT_GT(stopped.stats.tau, full.stats.tau) << "the continuation lowers τ";
+  EXPECT_EQ(stopped.stats.n_tau_iterations, 0);
+  // Continuing gives the full run.
+  o.continue_before_tau = [](int) { return true; };
+  EXPECT_TRUE(compute_seamless_param(mesh, o).uv.corner_uv == full.uv.corner_uv);
+  // Two components: not asked.
+  core::TriMesh a = test::make_icosphere(1), b = test::make_icosphere(1);
+  core::TriMesh two;
+  two.V.resize(a.V.rows() + b.V.rows(), 3);
+  two.V << a.V, (b.V.array() + 3.0).matrix();
+  two.F.resize(a.F.rows() + b.F.rows(), 3);
+  two.F << a.F, (b.F.array() + static_cast<int>(a.V.rows())).matrix();
+  asked.clear();
+  o.continue_before_tau = [&](int n_cones) {
+    asked.push_back(n_cones);
+    return false;
+  };
+  const ParamResult r2 = compute_seamless_param(two, o);
+  EXPECT_TRUE(asked.empty());
+  EXPECT_FALSE(r2.stats.stopped_before_tau);
+}
+
 TEST(SeamlessParam, TwoComponentsAreDeterministicAcrossThreadCounts) {
   core::TriMesh a = test::make_icosphere(1), b = test::make_torus(16, 8);
   core::TriMesh m;

@@ -259,14 +259,21 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     report["quantize"] = quantize_json(result);
     return result;
   };
-  param::ParamResult seamless = parametrize(param_options);
   // Coarse cones by default: a feature-free map with more cones than the grid has room for (they
   // follow the tessellation's curvature, not the target density) is parametrized again with its
-  // matchings rounded on a smoothed copy; if that fails, the map stays as it is.
-  auto coarsen = [&]() {
+  // matchings rounded on a smoothed copy; if that fails, the map stays as it is. The scale for a
+  // map of n cones, 0 for none.
+  auto coarse_cone_scale = [&](int n_cones) {
     if (args.cone_scale >= 0 || !param_options.feature_edges.empty() || !param_options.face_direction.empty())
-      return;
-    const double scale = quantize::recommended_cone_scale(mesh, quantize_options, seamless.stats.n_cones);
+      return 0.0;
+    return quantize::recommended_cone_scale(mesh, quantize_options, n_cones);
+  };
+  // A map that coarse cones will replace stops before τ's continuation (its cones are all that is
+  // used); it is parametrized in full only if the coarse maps fail.
+  param_options.continue_before_tau = [&](int n_cones) { return !(coarse_cone_scale(n_cones) > 0); };
+  param::ParamResult seamless = parametrize(param_options);
+  auto coarsen = [&]() {
+    const double scale = coarse_cone_scale(seamless.stats.n_cones);
     if (!(scale > 0)) return;
     if (!common.quiet)
       std::fprintf(stderr,
@@ -278,6 +285,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     // If that copy's map cannot be used, once more on a copy smoothed kCoarseRetryFactor more.
     for (int attempt = 0; attempt < 2; ++attempt) {
       param::ParamOptions coarse_options = param_options;
+      coarse_options.continue_before_tau = nullptr;
       coarse_options.cone_scale = attempt == 0 ? scale : kCoarseRetryFactor * scale;
       coarse_options.cone_scale_fallback = false;
       progress.begin("param");
@@ -296,6 +304,11 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      coarse_reason.c_str(),
                      attempt == 0 ? "; trying a smoother copy" : "; keeping the map's cones");
     }
+    if (seamless.stats.stopped_before_tau) {
+      param::ParamOptions full_options = param_options;
+      full_options.continue_before_tau = nullptr;
+      seamless = parametrize(full_options);
+    }
   };
   coarsen();
   quantize_options.feature_time_budget_seconds =
@@ -313,18 +326,31 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       return !(thin_field()[de.cone_vertex] < kThinDeadEndSize);
     };
   quantize::QuantizeResult integer_map = quantize_map(seamless);
+  // A cone of index 3 or more (a quad vertex of valence 1, which the quantization refuses) in a
+  // map the features shaped: without them the map gets coarse cones and cone splitting
+  // (mannequin-devil at 5,000 quads: index 3 at a horn tip with its creases, also after the
+  // thin-part retry; without them 38 cones).
+  std::string bad_cone_reason;
+  if (seamless.stats.n_aligned_features > 0)
+    for (const param::ConeInfo& c : seamless.cones)
+      if (c.index >= 3) {
+        bad_cone_reason = "the map with them has a cone of index " + std::to_string(c.index) + " at vertex " +
+                          std::to_string(c.vertex) + ", a quad vertex of valence " + std::to_string(4 - c.index);
+        break;
+      }
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
-  if (integer_map.stats.features_dropped &&
-      (integer_map.status.is_ok() || integer_map.status.code() == core::StatusCode::kNotConverged)) {
+  if ((integer_map.stats.features_dropped &&
+       (integer_map.status.is_ok() || integer_map.status.code() == core::StatusCode::kNotConverged)) ||
+      !bad_cone_reason.empty()) {
     features_dropped = true;
-    features_dropped_reason = integer_map.stats.features_dropped_reason;
+    features_dropped_reason = bad_cone_reason.empty() ? integer_map.stats.features_dropped_reason : bad_cone_reason;
     if (!common.quiet)
       std::fprintf(stderr,
                    "quadify: %s: the aligned features do not fit the quad grid at this density (%s; "
                    "%.0f s spent on them); remeshing without them (a larger --target-faces may keep "
                    "them, --feature-angle 0%s skips them from the start)\n",
-                   args.input.c_str(), integer_map.stats.features_dropped_reason.c_str(),
+                   args.input.c_str(), features_dropped_reason.c_str(),
                    seamless.stats.seconds_total + integer_map.stats.seconds,
                    core::topology_stats(mesh).n_boundary_loops > 0 ? " --no-boundary-alignment" : "");
     param_options.feature_edges.clear();

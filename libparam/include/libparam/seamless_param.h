@@ -163,6 +163,14 @@ struct ParamOptions {
   // the L^p continuation, out of 64). Calls are serialized, but with several components they may
   // come from worker threads.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
+  // Optional: asked once the matchings are final (after the last batch, the cone-pair
+  // cancellation and the cone splits), before τ's L^p continuation, with the number of cones;
+  // only with Energy::kTau, on a mesh of one component (with several, the cones are known only
+  // together) and without coarse cones (cone_scale 0 or its fallback). Returning false skips the continuation: the result keeps the last batch's
+  // symmetric Dirichlet layout (seamless and flip-free, converged less tightly) and sets
+  // ParamStats::stopped_before_tau. For a caller that only needs the cones to decide what to do
+  // next (the remesher's coarse cones).
+  std::function<bool(int n_cones)> continue_before_tau;
 };
 
 struct ParamStats {
@@ -176,6 +184,7 @@ struct ParamStats {
   int n_split_cones = 0;       // units of index moved off cones by cone splitting
   int n_deferred_matchings = 0;  // seams whose rounding a batch deferred (flips near them)
   bool coarse_cones = false;   // the matchings were rounded on the smoothed copy (cone_scale)
+  bool stopped_before_tau = false;  // ParamOptions::continue_before_tau returned false
   std::string coarse_cones_fallback_reason;  // why cone_scale was asked for but not used
   int n_feature_edges = 0;     // feature edges asked for (listed, plus boundaries if aligned)
   int n_aligned_features = 0;  // feature edges aligned in the result (see ParamResult::features)
