@@ -122,14 +122,11 @@ double batch_threshold(const ParamOptions& o, int i) {
 }
 
 // feature_edges: component-local vertex pairs of feature edges (edges of `mesh`).
-// `tau_continuation`: with Energy::kTau, converge the final layout by the L^p continuation; off
-// for a map whose layout is redone anyway (the smoothed copy of coarse cones), which keeps the
-// last batch's symmetric Dirichlet layout.
 ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& options,
                               const std::vector<std::array<int, 2>>& feature_edges,
                               const std::vector<double>& face_size,
                               const std::vector<Eigen::Matrix3d>& face_metric,
-                              const std::vector<Eigen::Vector3d>& face_direction, bool tau_continuation) {
+                              const std::vector<Eigen::Vector3d>& face_direction) {
   ComponentOutput out;
   const auto t0 = Clock::now();
   const CutMesh cut = cut_along_dual_tree(mesh, 0, face_size, face_metric);
@@ -781,7 +778,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     red_problem.reset();
     out.stats.seconds_optimize += seconds_since(to);
   }
-  if (options.energy == Energy::kTau && tau_continuation && options.continue_before_tau && out.status.is_ok()) {
+  bool tau_continuation = options.energy == Energy::kTau;
+  if (tau_continuation && options.continue_before_tau && out.status.is_ok()) {
     const std::vector<int> index = vertex_indices(mesh, cut, x);
     const int n_cones = static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; }));
     if (!options.continue_before_tau(n_cones)) {
@@ -789,7 +787,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       out.stats.stopped_before_tau = true;
     }
   }
-  if (options.energy == Energy::kTau && tau_continuation) {
+  if (tau_continuation) {
     const auto to = Clock::now();
     if (penalty_rows) {
       update_penalty_rows();
@@ -958,7 +956,9 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   return core::Status::ok();
 }
 
-ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& options, bool tau_continuation) {
+}  // namespace
+
+ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions& options) {
   ParamResult result;
   const auto t0 = Clock::now();
   result.uv.mesh = mesh;
@@ -973,8 +973,7 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
     core::TriMesh smoothed;
     core::Status s = smooth_for_cones(mesh, options.cone_scale, &smoothed);
     if (s.is_ok()) {
-      // Only its matchings are kept: relayout_on_mesh optimizes the layout on the mesh itself.
-      const ParamResult coarse = seamless_param(smoothed, fine_options, false);
+      const ParamResult coarse = compute_seamless_param(smoothed, fine_options);
       s = coarse.status;
       // A cone of index 3 or more (UV angle π/2 or less: the tip of a thin part that the
       // smoothing sharpened into a needle) would be a quad vertex of valence 1 or less, which no
@@ -1082,14 +1081,13 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
   std::vector<char> fell_back(n_comp, 0);
   auto work = [&](int c) {
     outs[c] = run_component(sub[c], component_options, sub_features[c], sub_size[c], sub_metric[c],
-                            sub_direction[c], tau_continuation);
+                            sub_direction[c]);
     if (outs[c].status.is_ok() || outs[c].status.code() == core::StatusCode::kInvalidInput ||
         outs[c].stats.n_feature_edges == 0)
       return;
     const int n_features = outs[c].stats.n_feature_edges;
     const std::string reason = outs[c].status.message();
-    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c], sub_direction[c],
-                            tau_continuation);
+    outs[c] = run_component(sub[c], plain_options, {}, sub_size[c], sub_metric[c], sub_direction[c]);
     outs[c].stats.n_feature_edges = n_features;
     outs[c].stats.n_disabled_features = n_features;
     outs[c].stats.feature_fallback_reason = reason;
@@ -1181,12 +1179,6 @@ ParamResult seamless_param(const core::TriMesh& mesh, const ParamOptions& option
   st.coarse_cones_fallback_reason = coarse_fallback;
   st.seconds_total = seconds_since(t0);
   return result;
-}
-
-}  // namespace
-
-ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions& options) {
-  return seamless_param(mesh, options, true);
 }
 
 }  // namespace quadify::param
