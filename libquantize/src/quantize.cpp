@@ -72,6 +72,9 @@ using Clock = std::chrono::steady_clock;
 // Default density: one quad per this many triangles, and at least kMinDefaultQuads quads.
 constexpr int kDefaultTrianglesPerQuad = 6;
 constexpr int kMinDefaultQuads = 100;
+// Components below this many quads (at the scale of an attempt's target) may keep cones of
+// index 3 or more: the grid cannot resolve them (see quantize_seamless).
+constexpr double kMinQuadsForCones = 16;
 // Free variables are rounded to multiples of 2^-kDyadicBits UV units (a quad is 1 unit), far
 // below any triangle's size, so the rounding cannot flip a triangle in practice (checked).
 constexpr int kDyadicBits = 30;
@@ -730,17 +733,6 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                                              " flipped or degenerate faces");
     return out;
   }
-  // A cone of index 3 or more (UV angle 90° or less) would be a quad vertex of valence 1 or 0:
-  // extraction refuses it, so no rounding is tried (octopus spent 150 s on such a map).
-  for (const param::ConeInfo& c : seamless.cones)
-    if (c.index >= 3) {
-      out.status = core::Status::invalid_input(
-          "cone vertex " + std::to_string(c.vertex) + " has index " + std::to_string(c.index) + " (UV angle " +
-          std::to_string(90 * (4 - c.index)) +
-          "°): no quad mesh has a vertex of valence " + std::to_string(4 - c.index) +
-          " (split such cones: param::ParamOptions::cone_split_distance)");
-      return out;
-    }
   // Cones and the gauge copy of each component.
   std::vector<char> is_cone_vertex(mesh.n_vertices(), 0);
   for (const param::ConeInfo& c : seamless.cones) {
@@ -851,6 +843,31 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     return out;
   }
 
+  // A cone of index 3 or more (UV angle 90° or less) would be a quad vertex of valence 1 or 0:
+  // extraction refuses it, so no rounding is tried (octopus spent 150 s on such a map). Except in
+  // a component of less than kMinQuadsForCones quads at this scale, which the grid cannot resolve
+  // anyway (the remesher extracts without it and splits its triangles): the tetrahedron that the
+  // repair splits off spot_nonmanifold (6.6 quads) has four cones and no room to move one.
+  {
+    std::vector<double> component_quads(cl.n_components, 0.0);
+    for (int f = 0; f < nf; ++f) {
+      const int k0 = cl.corner_copy[3 * f], k1 = cl.corner_copy[3 * f + 1], k2 = cl.corner_copy[3 * f + 2];
+      const Eigen::Vector2d e1 = cl.x.segment<2>(2 * k1) - cl.x.segment<2>(2 * k0),
+                            e2 = cl.x.segment<2>(2 * k2) - cl.x.segment<2>(2 * k0);
+      component_quads[cl.copy_component[k0]] += 0.5 * scale * scale * (e1.x() * e2.y() - e1.y() * e2.x());
+    }
+    std::vector<int> vertex_component(mesh.n_vertices(), -1);
+    for (int k = 0; k < cl.n_copies(); ++k) vertex_component[cl.copy_vertex[k]] = cl.copy_component[k];
+    for (const param::ConeInfo& c : seamless.cones)
+      if (c.index >= 3 && component_quads[vertex_component[c.vertex]] >= kMinQuadsForCones) {
+        out.status = core::Status::invalid_input(
+            "cone vertex " + std::to_string(c.vertex) + " has index " + std::to_string(c.index) + " (UV angle " +
+            std::to_string(90 * (4 - c.index)) +
+            "°): no quad mesh has a vertex of valence " + std::to_string(4 - c.index) +
+            " (split such cones: param::ParamOptions::cone_split_distance)");
+        return out;
+      }
+  }
   param::PinnedLayoutOptions lopt;
   lopt.energy = options.energy;
   lopt.face_size = options.face_size;

@@ -121,6 +121,11 @@ TEST(QuantizeSeamless, ConeOfIndexThreeIsRefusedBeforeRounding) {
             std::string::npos)
       << q.status.message();
   EXPECT_EQ(q.stats.n_rounded, 0);
+  // Below 16 quads (kMinQuadsForCones) the grid cannot resolve the spike anyway: the map is not
+  // refused (the remesher extracts without such a component and splits its triangles).
+  qo.target_faces = 8;
+  const quantize::QuantizeResult tiny = quantize::quantize_seamless(mesh, map, qo);
+  EXPECT_NE(tiny.status.code(), core::StatusCode::kInvalidInput) << tiny.status.to_string();
 }
 
 TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {

@@ -436,9 +436,49 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
 
   quadex::ExtractOptions extract_options;
   extract_options.output_uv = args.keep_uv;
+  // A component that keeps a cone of index 3 or more (the quantization lets it through below a few
+  // quads: spot_nonmanifold's tetrahedron) is left out of the extraction; with no faces it is
+  // replaced by its split triangles below (split_small_components, at most 64 triangles).
+  const quadex::SmallComponentOptions small_options;
   auto extract = [&](const quantize::QuantizeResult& map) {
     progress.begin("extract");
-    quadex::ExtractResult result = quadex::extract_quads(map.uv, extract_options);
+    const core::TriMesh& m = map.uv.mesh;
+    std::vector<char> left_out(m.n_faces(), 0);
+    if (std::any_of(seamless.cones.begin(), seamless.cones.end(), [](const param::ConeInfo& c) { return c.index >= 3; })) {
+      std::vector<int> component;
+      const int n_comp = core::face_components(m, core::build_edge_topology(m), &component);
+      std::vector<int> comp_faces(n_comp, 0);
+      std::vector<char> comp_bad(n_comp, 0), vertex_bad(m.n_vertices(), 0);
+      for (const param::ConeInfo& c : seamless.cones)
+        if (c.index >= 3) vertex_bad[c.vertex] = 1;
+      for (int f = 0; f < m.n_faces(); ++f) {
+        ++comp_faces[component[f]];
+        for (int k = 0; k < 3; ++k) comp_bad[component[f]] |= vertex_bad[m.F(f, k)];
+      }
+      for (int f = 0; f < m.n_faces(); ++f)
+        left_out[f] = comp_bad[component[f]] && comp_faces[component[f]] <= small_options.max_triangles;
+    }
+    const int n_left_out = static_cast<int>(std::count(left_out.begin(), left_out.end(), 1));
+    if (n_left_out == 0 || n_left_out == m.n_faces()) {
+      quadex::ExtractResult result = quadex::extract_quads(map.uv, extract_options);
+      progress.end();
+      return result;
+    }
+    core::UVMesh kept;
+    kept.mesh.V = m.V;
+    kept.mesh.F.resize(m.n_faces() - n_left_out, 3);
+    kept.corner_uv.resize(3 * kept.mesh.F.rows(), 2);
+    std::vector<int> kept_face;
+    for (int f = 0; f < m.n_faces(); ++f)
+      if (!left_out[f]) {
+        const int i = static_cast<int>(kept_face.size());
+        kept.mesh.F.row(i) = m.F.row(f);
+        kept.corner_uv.middleRows(3 * i, 3) = map.uv.corner_uv.middleRows(3 * f, 3);
+        kept_face.push_back(f);
+      }
+    quadex::ExtractResult result = quadex::extract_quads(kept, extract_options);
+    for (int& f : result.vertex_face)
+      if (f >= 0) f = kept_face[f];
     progress.end();
     return result;
   };
@@ -467,7 +507,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     extracted = std::move(finer_quads);
   }
   // Components too small for the grid (degenerate or non-quad faces): their triangles split.
-  quadex::SmallComponentResult small = quadex::split_small_components(integer_map.uv, extracted.quads, extracted.vertex_face);
+  quadex::SmallComponentResult small =
+      quadex::split_small_components(integer_map.uv, extracted.quads, extracted.vertex_face, small_options);
   if (!small.status.is_ok())
     throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
   if (small.stats.n_replaced > 0) {
