@@ -150,15 +150,18 @@ int default_target_faces(const core::TriMesh& mesh) {
   return std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
 }
 
+// Signed UV area of face f.
+double face_uv_area(const param::CopyLayout& cl, const Eigen::VectorXd& x, int f) {
+  const Eigen::Vector2d p0 = x.segment<2>(2 * cl.corner_copy[3 * f]),
+                        p1 = x.segment<2>(2 * cl.corner_copy[3 * f + 1]),
+                        p2 = x.segment<2>(2 * cl.corner_copy[3 * f + 2]);
+  const Eigen::Vector2d e1 = p1 - p0, e2 = p2 - p0;
+  return 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
+}
+
 double uv_area(const param::CopyLayout& cl, const Eigen::VectorXd& x, int nf) {
   double a = 0;
-  for (int f = 0; f < nf; ++f) {
-    const Eigen::Vector2d p0 = x.segment<2>(2 * cl.corner_copy[3 * f]),
-                          p1 = x.segment<2>(2 * cl.corner_copy[3 * f + 1]),
-                          p2 = x.segment<2>(2 * cl.corner_copy[3 * f + 2]);
-    const Eigen::Vector2d e1 = p1 - p0, e2 = p2 - p0;
-    a += 0.5 * (e1.x() * e2.y() - e1.y() * e2.x());
-  }
+  for (int f = 0; f < nf; ++f) a += face_uv_area(cl, x, f);
   return a;
 }
 
@@ -850,12 +853,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   // repair splits off spot_nonmanifold (6.6 quads) has four cones and no room to move one.
   {
     std::vector<double> component_quads(cl.n_components, 0.0);
-    for (int f = 0; f < nf; ++f) {
-      const int k0 = cl.corner_copy[3 * f], k1 = cl.corner_copy[3 * f + 1], k2 = cl.corner_copy[3 * f + 2];
-      const Eigen::Vector2d e1 = cl.x.segment<2>(2 * k1) - cl.x.segment<2>(2 * k0),
-                            e2 = cl.x.segment<2>(2 * k2) - cl.x.segment<2>(2 * k0);
-      component_quads[cl.copy_component[k0]] += 0.5 * scale * scale * (e1.x() * e2.y() - e1.y() * e2.x());
-    }
+    for (int f = 0; f < nf; ++f)
+      component_quads[cl.copy_component[cl.corner_copy[3 * f]]] += scale * scale * face_uv_area(cl, cl.x, f);
     std::vector<int> vertex_component(mesh.n_vertices(), -1);
     for (int k = 0; k < cl.n_copies(); ++k) vertex_component[cl.copy_vertex[k]] = cl.copy_component[k];
     for (const param::ConeInfo& c : seamless.cones)

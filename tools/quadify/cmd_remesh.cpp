@@ -88,6 +88,30 @@ void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* option
   }
 }
 
+// The faces of the components of `mesh` with at most max_triangles triangles that keep a cone of
+// index 3 or more (the quantization lets such a cone through below a few quads), which the
+// extraction would refuse; empty when there is none.
+std::vector<int> faces_left_out_of_extraction(const core::TriMesh& mesh, const std::vector<param::ConeInfo>& cones,
+                                              int max_triangles) {
+  std::vector<char> vertex_bad(mesh.n_vertices(), 0);
+  bool any = false;
+  for (const param::ConeInfo& c : cones)
+    if (c.index >= 3) vertex_bad[c.vertex] = any = true;
+  if (!any) return {};
+  std::vector<int> component;
+  const int n_comp = core::face_components(mesh, core::build_edge_topology(mesh), &component);
+  std::vector<int> comp_faces(n_comp, 0);
+  std::vector<char> comp_bad(n_comp, 0);
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    ++comp_faces[component[f]];
+    for (int k = 0; k < 3; ++k) comp_bad[component[f]] |= vertex_bad[mesh.F(f, k)];
+  }
+  std::vector<int> faces;
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    if (comp_bad[component[f]] && comp_faces[component[f]] <= max_triangles) faces.push_back(f);
+  return faces;
+}
+
 
 int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMesh& loaded, Progress& progress,
                   nlohmann::json* report_out);
@@ -440,45 +464,34 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // quads: spot_nonmanifold's tetrahedron) is left out of the extraction; with no faces it is
   // replaced by its split triangles below (split_small_components, at most 64 triangles).
   const quadex::SmallComponentOptions small_options;
+  // The faces kept, in order, when some are left out (the map's mesh and cones are fixed from here).
+  const std::vector<int> left_out =
+      faces_left_out_of_extraction(mesh, seamless.cones, small_options.max_triangles);
+  std::vector<int> kept_face;
+  if (!left_out.empty() && static_cast<int>(left_out.size()) < mesh.n_faces())
+    for (int f = 0, i = 0; f < mesh.n_faces(); ++f)
+      if (i < static_cast<int>(left_out.size()) && left_out[i] == f)
+        ++i;
+      else
+        kept_face.push_back(f);
   auto extract = [&](const quantize::QuantizeResult& map) {
     progress.begin("extract");
-    const core::TriMesh& m = map.uv.mesh;
-    std::vector<char> left_out(m.n_faces(), 0);
-    if (std::any_of(seamless.cones.begin(), seamless.cones.end(), [](const param::ConeInfo& c) { return c.index >= 3; })) {
-      std::vector<int> component;
-      const int n_comp = core::face_components(m, core::build_edge_topology(m), &component);
-      std::vector<int> comp_faces(n_comp, 0);
-      std::vector<char> comp_bad(n_comp, 0), vertex_bad(m.n_vertices(), 0);
-      for (const param::ConeInfo& c : seamless.cones)
-        if (c.index >= 3) vertex_bad[c.vertex] = 1;
-      for (int f = 0; f < m.n_faces(); ++f) {
-        ++comp_faces[component[f]];
-        for (int k = 0; k < 3; ++k) comp_bad[component[f]] |= vertex_bad[m.F(f, k)];
+    quadex::ExtractResult result;
+    if (kept_face.empty()) {
+      result = quadex::extract_quads(map.uv, extract_options);
+    } else {
+      core::UVMesh kept;
+      kept.mesh.V = map.uv.mesh.V;
+      kept.mesh.F.resize(static_cast<Eigen::Index>(kept_face.size()), 3);
+      kept.corner_uv.resize(3 * kept.mesh.F.rows(), 2);
+      for (size_t i = 0; i < kept_face.size(); ++i) {
+        kept.mesh.F.row(i) = map.uv.mesh.F.row(kept_face[i]);
+        kept.corner_uv.middleRows(3 * i, 3) = map.uv.corner_uv.middleRows(3 * kept_face[i], 3);
       }
-      for (int f = 0; f < m.n_faces(); ++f)
-        left_out[f] = comp_bad[component[f]] && comp_faces[component[f]] <= small_options.max_triangles;
+      result = quadex::extract_quads(kept, extract_options);
+      for (int& f : result.vertex_face)
+        if (f >= 0) f = kept_face[f];
     }
-    const int n_left_out = static_cast<int>(std::count(left_out.begin(), left_out.end(), 1));
-    if (n_left_out == 0 || n_left_out == m.n_faces()) {
-      quadex::ExtractResult result = quadex::extract_quads(map.uv, extract_options);
-      progress.end();
-      return result;
-    }
-    core::UVMesh kept;
-    kept.mesh.V = m.V;
-    kept.mesh.F.resize(m.n_faces() - n_left_out, 3);
-    kept.corner_uv.resize(3 * kept.mesh.F.rows(), 2);
-    std::vector<int> kept_face;
-    for (int f = 0; f < m.n_faces(); ++f)
-      if (!left_out[f]) {
-        const int i = static_cast<int>(kept_face.size());
-        kept.mesh.F.row(i) = m.F.row(f);
-        kept.corner_uv.middleRows(3 * i, 3) = map.uv.corner_uv.middleRows(3 * f, 3);
-        kept_face.push_back(f);
-      }
-    quadex::ExtractResult result = quadex::extract_quads(kept, extract_options);
-    for (int& f : result.vertex_face)
-      if (f >= 0) f = kept_face[f];
     progress.end();
     return result;
   };
