@@ -56,6 +56,14 @@ SmallComponentResult split_small_components(const core::UVMesh& map, const core:
   for (int c = 0; c < n_components; ++c)
     replace[c] = (broken[c] || n_faces[c] == 0) && n_faces[c] <= options.max_faces &&
                  n_triangles[c] <= options.max_triangles;
+  for (const int f : options.replace_faces) {
+    if (f < 0 || f >= nf) {
+      res.status = core::Status::invalid_input("split_small_components: replace_faces holds face " +
+                                               std::to_string(f) + " of " + std::to_string(nf));
+      return res;
+    }
+    replace[component[f]] = 1;
+  }
   for (int c = 0; c < n_components; ++c) res.stats.n_replaced += replace[c];
   if (res.stats.n_replaced == 0) {
     res.quads = quads;

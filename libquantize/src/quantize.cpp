@@ -857,6 +857,13 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
       component_quads[cl.copy_component[cl.corner_copy[3 * f]]] += scale * scale * face_uv_area(cl, cl.x, f);
     std::vector<int> vertex_component(mesh.n_vertices(), -1);
     for (int k = 0; k < cl.n_copies(); ++k) vertex_component[cl.copy_vertex[k]] = cl.copy_component[k];
+    std::vector<char> component_unresolved(cl.n_components, 0);
+    for (const param::ConeInfo& c : seamless.cones)
+      if (c.index >= 3 && component_quads[vertex_component[c.vertex]] < kMinQuadsForCones)
+        component_unresolved[vertex_component[c.vertex]] = 1;
+    for (int f = 0; f < nf; ++f)
+      if (component_unresolved[cl.copy_component[cl.corner_copy[3 * f]]])
+        out.stats.faces_with_unresolved_cones.push_back(f);
     for (const param::ConeInfo& c : seamless.cones)
       if (c.index >= 3 && component_quads[vertex_component[c.vertex]] >= kMinQuadsForCones) {
         out.status = core::Status::invalid_input(

@@ -1,6 +1,7 @@
 // split_small_components: a tetrahedron smaller than a quad, extracted as four "quads" with a
-// repeated vertex, becomes twelve quads on its own faces; a proper quad component and a large
-// component with a non-quad face stay as they are; bad input is rejected.
+// repeated vertex, becomes twelve quads on its own faces (also when a caller left it out of the
+// extraction); a proper quad component and a large component with a non-quad face stay as they
+// are; bad input is rejected.
 #include <libquadex/quad_metrics.h>
 #include <libquadex/small_components.h>
 
@@ -93,6 +94,31 @@ TEST(SmallComponents, KeepsProperQuadsAndLargeComponents) {
   EXPECT_EQ(d.quads.n_faces(), 7);
 }
 
+TEST(SmallComponents, ACallerCanHaveAComponentReplacedWhateverItsSize) {
+  // The extraction left the tetrahedron out (as the remesher does with a component that keeps a
+  // cone of index 3): it must not vanish, even above max_triangles.
+  const core::UVMesh map = square_and_tetrahedron();
+  core::PolyMesh q;
+  q.V.resize(4, 3);
+  q.V << 0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0;
+  q.add_face({0, 1, 2, 3});
+  SmallComponentOptions options;
+  options.max_triangles = 1;
+  EXPECT_EQ(split_small_components(map, q, {0, 0, 0, 1}, options).stats.n_replaced, 0) << "too large";
+  options.replace_faces = {3};
+  const SmallComponentResult r = split_small_components(map, q, {0, 0, 0, 1}, options);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.stats.n_replaced, 1);
+  EXPECT_EQ(r.stats.n_faces_removed, 0);
+  EXPECT_EQ(r.stats.n_quads_added, 12);
+  ASSERT_EQ(r.quads.n_faces(), 13);
+  expect_each_directed_edge_once(r.quads);
+  const QuadMetrics m = compute_quad_metrics(r.quads, &map.mesh);
+  EXPECT_EQ(m.n_non_quads, 0);
+  EXPECT_EQ(m.n_flipped, 0);
+  EXPECT_EQ(m.n_components, 2);
+}
+
 TEST(SmallComponents, RejectsMismatchedInput) {
   const core::UVMesh map = square_and_tetrahedron();
   core::PolyMesh q;
@@ -101,6 +127,9 @@ TEST(SmallComponents, RejectsMismatchedInput) {
   q.add_face({0, 1, 2, 3});
   EXPECT_EQ(split_small_components(map, q, {0, 0, 0}).status.code(), core::StatusCode::kInvalidInput);
   EXPECT_EQ(split_small_components(map, q, {0, 0, 0, 99}).status.code(), core::StatusCode::kInvalidInput);
+  SmallComponentOptions options;
+  options.replace_faces = {6};  // the map has faces 0-5
+  EXPECT_EQ(split_small_components(map, q, {0, 0, 0, 0}, options).status.code(), core::StatusCode::kInvalidInput);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 #include <tuple>
 #include <vector>
 
@@ -121,11 +122,15 @@ TEST(QuantizeSeamless, ConeOfIndexThreeIsRefusedBeforeRounding) {
             std::string::npos)
       << q.status.message();
   EXPECT_EQ(q.stats.n_rounded, 0);
+  EXPECT_TRUE(q.stats.faces_with_unresolved_cones.empty()) << "refused, not let through";
   // Below 16 quads (kMinQuadsForCones) the grid cannot resolve the spike anyway: the map is not
-  // refused (the remesher extracts without such a component and splits its triangles).
+  // refused, and its faces (one component: all of them) are named for the extraction to leave out.
   qo.target_faces = 8;
   const quantize::QuantizeResult tiny = quantize::quantize_seamless(mesh, map, qo);
   EXPECT_NE(tiny.status.code(), core::StatusCode::kInvalidInput) << tiny.status.to_string();
+  std::vector<int> all_faces(mesh.n_faces());
+  std::iota(all_faces.begin(), all_faces.end(), 0);
+  EXPECT_EQ(tiny.stats.faces_with_unresolved_cones, all_faces);
 }
 
 TEST(QuantizeSeamless, BoxCreasesBecomeQuadEdges) {

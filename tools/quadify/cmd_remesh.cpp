@@ -88,28 +88,18 @@ void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* option
   }
 }
 
-// The faces of the components of `mesh` with at most max_triangles triangles that keep a cone of
-// index 3 or more (the quantization lets such a cone through below a few quads), which the
-// extraction would refuse; empty when there is none.
-std::vector<int> faces_left_out_of_extraction(const core::TriMesh& mesh, const std::vector<param::ConeInfo>& cones,
-                                              int max_triangles) {
-  std::vector<char> vertex_bad(mesh.n_vertices(), 0);
-  bool any = false;
-  for (const param::ConeInfo& c : cones)
-    if (c.index >= 3) vertex_bad[c.vertex] = any = true;
-  if (!any) return {};
-  std::vector<int> component;
-  const int n_comp = core::face_components(mesh, core::build_edge_topology(mesh), &component);
-  std::vector<int> comp_faces(n_comp, 0);
-  std::vector<char> comp_bad(n_comp, 0);
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    ++comp_faces[component[f]];
-    for (int k = 0; k < 3; ++k) comp_bad[component[f]] |= vertex_bad[mesh.F(f, k)];
-  }
-  std::vector<int> faces;
-  for (int f = 0; f < mesh.n_faces(); ++f)
-    if (comp_bad[component[f]] && comp_faces[component[f]] <= max_triangles) faces.push_back(f);
-  return faces;
+// The cone of index 3 or more (a quad vertex of valence 1 or 0) for which the quantization
+// refused `map` (kInvalidInput): one outside the components it lets keep such a cone
+// (QuantizeStats::faces_with_unresolved_cones); null when it did not refuse the map for a cone.
+const param::ConeInfo* refused_cone(const core::TriMesh& mesh, const param::ParamResult& map,
+                                    const quantize::QuantizeResult& quantized) {
+  if (quantized.status.code() != core::StatusCode::kInvalidInput) return nullptr;
+  std::vector<char> unresolved(mesh.n_vertices(), 0);
+  for (const int f : quantized.stats.faces_with_unresolved_cones)
+    for (int k = 0; k < 3; ++k) unresolved[mesh.F(f, k)] = 1;
+  for (const param::ConeInfo& c : map.cones)
+    if (c.index >= 3 && !unresolved[c.vertex]) return &c;
+  return nullptr;
 }
 
 
@@ -356,12 +346,9 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // thin-part retry; without them 38 cones).
   std::string bad_cone_reason;
   if (seamless.stats.n_aligned_features > 0)
-    for (const param::ConeInfo& c : seamless.cones)
-      if (c.index >= 3) {
-        bad_cone_reason = "the map with them has a cone of index " + std::to_string(c.index) + " at vertex " +
-                          std::to_string(c.vertex) + ", a quad vertex of valence " + std::to_string(4 - c.index);
-        break;
-      }
+    if (const param::ConeInfo* c = refused_cone(mesh, seamless, integer_map))
+      bad_cone_reason = "the map with them has a cone of index " + std::to_string(c->index) + " at vertex " +
+                        std::to_string(c->vertex) + ", a quad vertex of valence " + std::to_string(4 - c->index);
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
   if ((integer_map.stats.features_dropped &&
@@ -391,8 +378,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // radius there (param::thin_part_vertex_size; the count stays).
   const bool dead_end = (integer_map.status.code() == core::StatusCode::kNotConverged &&
                          !integer_map.stats.out_of_time) ||
-                        std::any_of(seamless.cones.begin(), seamless.cones.end(),
-                                    [](const param::ConeInfo& c) { return c.index >= 3; });
+                        refused_cone(mesh, seamless, integer_map) != nullptr;
   if (dead_end && thin_retry_allowed) {
     thin_field();
     double thin_area = 0, area = 0;
@@ -461,25 +447,22 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   quadex::ExtractOptions extract_options;
   extract_options.output_uv = args.keep_uv;
   // A component that keeps a cone of index 3 or more (the quantization lets it through below a few
-  // quads: spot_nonmanifold's tetrahedron) is left out of the extraction; with no faces it is
-  // replaced by its split triangles below (split_small_components, at most 64 triangles).
-  const quadex::SmallComponentOptions small_options;
-  // The faces kept, in order, when some are left out (the map's mesh and cones are fixed from here).
-  const std::vector<int> left_out =
-      faces_left_out_of_extraction(mesh, seamless.cones, small_options.max_triangles);
-  std::vector<int> kept_face;
-  if (!left_out.empty() && static_cast<int>(left_out.size()) < mesh.n_faces())
-    for (int f = 0, i = 0; f < mesh.n_faces(); ++f)
-      if (i < static_cast<int>(left_out.size()) && left_out[i] == f)
-        ++i;
-      else
-        kept_face.push_back(f);
+  // quads: spot_nonmanifold's tetrahedron) is left out of the extraction and replaced by its split
+  // triangles below (split_small_components).
   auto extract = [&](const quantize::QuantizeResult& map) {
     progress.begin("extract");
+    const std::vector<int>& left_out = map.stats.faces_with_unresolved_cones;
     quadex::ExtractResult result;
-    if (kept_face.empty()) {
+    if (left_out.empty()) {
       result = quadex::extract_quads(map.uv, extract_options);
     } else {
+      // The kept faces, in order (none: no quads, every component is split below).
+      std::vector<int> kept_face;
+      for (int f = 0, i = 0; f < mesh.n_faces(); ++f)
+        if (i < static_cast<int>(left_out.size()) && left_out[i] == f)
+          ++i;
+        else
+          kept_face.push_back(f);
       core::UVMesh kept;
       kept.mesh.V = map.uv.mesh.V;
       kept.mesh.F.resize(static_cast<Eigen::Index>(kept_face.size()), 3);
@@ -488,9 +471,11 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         kept.mesh.F.row(i) = map.uv.mesh.F.row(kept_face[i]);
         kept.corner_uv.middleRows(3 * i, 3) = map.uv.corner_uv.middleRows(3 * kept_face[i], 3);
       }
-      result = quadex::extract_quads(kept, extract_options);
-      for (int& f : result.vertex_face)
-        if (f >= 0) f = kept_face[f];
+      if (!kept_face.empty()) {
+        result = quadex::extract_quads(kept, extract_options);
+        for (int& f : result.vertex_face)
+          if (f >= 0) f = kept_face[f];
+      }
     }
     progress.end();
     return result;
@@ -520,6 +505,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     extracted = std::move(finer_quads);
   }
   // Components too small for the grid (degenerate or non-quad faces): their triangles split.
+  quadex::SmallComponentOptions small_options;
+  small_options.replace_faces = integer_map.stats.faces_with_unresolved_cones;
   quadex::SmallComponentResult small =
       quadex::split_small_components(integer_map.uv, extracted.quads, extracted.vertex_face, small_options);
   if (!small.status.is_ok())
@@ -528,10 +515,11 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     extracted.quads = std::move(small.quads);
     if (!common.quiet)
       std::fprintf(stderr,
-                   "quadify: %s: %d component(s) too small for the quad grid (%d faces that were not "
-                   "all quads) became %d quads, three per input triangle\n",
-                   args.input.c_str(), small.stats.n_replaced, small.stats.n_faces_removed,
-                   small.stats.n_quads_added);
+                   "quadify: %s: %d component(s) too small for the quad grid became %d quads, three per "
+                   "input triangle (%d extracted faces that were not all quads removed; %zu triangles "
+                   "left out of the extraction for a cone of index 3 or more)\n",
+                   args.input.c_str(), small.stats.n_replaced, small.stats.n_quads_added,
+                   small.stats.n_faces_removed, integer_map.stats.faces_with_unresolved_cones.size());
   }
   quadex::RelaxStats relax_stats;
   if (args.relax) {

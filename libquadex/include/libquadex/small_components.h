@@ -19,6 +19,9 @@ struct SmallComponentOptions {
   // max_triangles input triangles.
   int max_faces = 16;
   int max_triangles = 64;
+  // Faces of the map whose components are replaced whatever their size (the faces a caller left
+  // out of the extraction, e.g. QuantizeStats::faces_with_unresolved_cones).
+  std::vector<int> replace_faces;
 };
 
 struct SmallComponentStats {

@@ -102,6 +102,12 @@ struct QuantizeStats {
   int n_batches = 0;        // constrained re-optimizations that succeeded
   int n_flipped = 0;        // flipped or degenerate faces of the result (exact predicate)
   int n_cones = 0;
+  // Faces (increasing) of the components that keep a cone of index 3 or more: a component of
+  // fewer than 16 quads at the target scale, which the grid cannot resolve, may keep one (a
+  // larger one is refused, kInvalidInput). Such a cone would be a quad vertex of valence 1 or 0:
+  // extract the quads without these faces (quadex::split_small_components replaces a component
+  // with no quads by its split triangles).
+  std::vector<int> faces_with_unresolved_cones;
   // Aligned features of the input map (param::FeatureAlignment) that the result has exactly on
   // integer iso-lines. Feature lines that reach no integer flip-free are released (left where
   // they are; n_released_feature_lines), unless a cone or translation depends on them. A cone or
