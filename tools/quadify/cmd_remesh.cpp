@@ -560,6 +560,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"moves", relax_stats.n_moves},
                        {"jumps", relax_stats.n_jumps},
                        {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
+                       {"unfolded", relax_stats.n_unfolded},
                        {"snapped", relax_stats.n_snapped},
                        {"fitted", relax_stats.n_fitted},
                        {"fit_distance_before", relax_stats.fit_distance_before},
