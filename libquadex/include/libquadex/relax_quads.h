@@ -62,7 +62,7 @@ struct RelaxOptions {
   // fit_rounds rounds. Vertices stay on the surface. It brings in tips and ridges that the quads
   // cut off. fit_fraction 0 = off.
   double fit_fraction = 0.8;
-  double fit_min_quality = 0.5;
+  double fit_min_quality = 0.2;
   int fit_rounds = 3;
   // Diagonal choice, before the shape fitting and after it: a quad is a bilinear patch for some
   // consumers, but OBJ viewers, glTF (written as triangles) and the metrics split it along its
