@@ -882,6 +882,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   lopt.direction_weight = options.direction_weight;
   lopt.gauge_copies = gauge;
   lopt.prefer_free = is_cone_copy;
+  lopt.max_element_entries = options.max_element_entries;
   const std::vector<Candidate> base_candidates(candidates.begin(),
                                                candidates.begin() + n_base_candidates);
   const Clock::time_point deadline =
@@ -990,6 +991,16 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                     attempts[attempt].features_last, with_features ? release : ReleaseFeatures{});
     const Rounder::Outcome outcome = rounder.run(x, lopt);
     st.n_integer_dofs = rounder.n_integer_columns();
+    if (outcome == Rounder::Outcome::kFailed && with_features && options.quantize_without_features &&
+        rounder.status().code() == core::StatusCode::kNumericalFailure) {
+      // With the features' rows eliminated, the layout can be too large to set up (dragon's
+      // feature map: long aligned lines couple up to 939 unknowns in one triangle): the
+      // features count as not fitting, and the attempts without them follow.
+      last_stuck = rounder.status().message();
+      st.features_dropped_reason = last_stuck;
+      while (attempt + 1 < static_cast<int>(attempts.size()) && attempts[attempt + 1].with_features) ++attempt;
+      continue;
+    }
     if (outcome == Rounder::Outcome::kFailed) {
       failure = rounder.status();
       break;

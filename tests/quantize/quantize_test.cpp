@@ -188,6 +188,33 @@ TEST(QuantizeSeamless, FeatureTimeBudgetDropsTheFeaturesNotTheMap) {
             core::StatusCode::kInvalidInput);
 }
 
+// A map whose re-optimization with the features' rows cannot be set up (the elimination above
+// max_element_entries, as dragon's feature map at 5,000 quads) counts as the features not
+// fitting: the attempts without them follow (here refused too, below one entry per face), the
+// reason is kept for the caller (the remesher then parametrizes without the features), and the
+// status is the last attempt's.
+TEST(QuantizeSeamless, FeatureRowsTooLargeToSetUpCountAsNotFitting) {
+  const core::TriMesh mesh = load("box.obj");
+  const FeatureRun kept = run_with_features(mesh, 200, false);
+  ASSERT_TRUE(kept.quantized.status.is_ok()) << kept.quantized.status.to_string();
+  ASSERT_FALSE(kept.quantized.stats.features_dropped);
+  EXPECT_TRUE(kept.quantized.stats.features_dropped_reason.empty());
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 200;
+  qo.max_element_entries = 0.5 * mesh.n_faces();
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, kept.param, qo);
+  EXPECT_EQ(q.status.code(), core::StatusCode::kNumericalFailure) << q.status.to_string();
+  EXPECT_NE(q.status.message().find("unknowns in one triangle"), std::string::npos) << q.status.message();
+  EXPECT_NE(q.stats.features_dropped_reason.find("unknowns in one triangle"), std::string::npos)
+      << "the features' layout was refused first: " << q.stats.features_dropped_reason;
+  EXPECT_GE(q.stats.n_scale_retries, 2) << "the attempts without the features were tried";
+  // Without the fallback (quantize_without_features = false) the refusal is the answer at once.
+  qo.quantize_without_features = false;
+  const quantize::QuantizeResult stopped = quantize::quantize_seamless(mesh, kept.param, qo);
+  EXPECT_EQ(stopped.status.code(), core::StatusCode::kNumericalFailure);
+  EXPECT_EQ(stopped.stats.n_scale_retries, 0);
+}
+
 // A plate with five square holes at a coarse grid: the holes are about a quad wide, and with
 // every crease aligned some translation around a hole has no flip-free integer. Only the
 // alignment rows near that dead end are released; the rest of the creases stay on iso-lines.

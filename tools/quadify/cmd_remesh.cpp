@@ -351,11 +351,17 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                         std::to_string(c->vertex) + ", a quad vertex of valence " + std::to_string(4 - c->index);
   // The features could not be kept on integer iso-lines: the map they shaped (more cones, more
   // distortion) is no longer worth its price, so parametrize and quantize again without them.
+  // A map whose quantization cannot be set up (kNumericalFailure: the elimination too large for
+  // its cones, dragon's feature map with 858) is no better.
+  const bool unusable_feature_map = seamless.stats.n_aligned_features > 0 &&
+                                    integer_map.status.code() == core::StatusCode::kNumericalFailure;
   if ((integer_map.stats.features_dropped &&
        (integer_map.status.is_ok() || integer_map.status.code() == core::StatusCode::kNotConverged)) ||
-      !bad_cone_reason.empty()) {
+      !bad_cone_reason.empty() || unusable_feature_map) {
     features_dropped = true;
-    features_dropped_reason = bad_cone_reason.empty() ? integer_map.stats.features_dropped_reason : bad_cone_reason;
+    features_dropped_reason = !bad_cone_reason.empty()    ? bad_cone_reason
+                              : unusable_feature_map ? integer_map.status.message()
+                                                     : integer_map.stats.features_dropped_reason;
     if (!common.quiet)
       std::fprintf(stderr,
                    "quadify: %s: the aligned features do not fit the quad grid at this density (%s; "

@@ -60,6 +60,10 @@ struct QuantizeOptions {
   bool quantize_without_features = true;
   // Allowed seam residual of the input |e_b − R^r e_a|, × its UV bounding-box diagonal.
   double input_seam_tol = 1e-6;
+  // Bound on the re-optimizations' element Hessians, as param::PinnedLayoutOptions::
+  // max_element_entries: a layout above it is refused (kNumericalFailure). With the aligned
+  // features' rows it counts as the features not fitting (see quantize_without_features).
+  double max_element_entries = 4e7;
   // Worker threads of the optimizer; 0 = all hardware threads. The result does not depend on it.
   int threads = 0;
   // Isotropic sizing: the same per-face sizes as param::ParamOptions::face_size (or empty). The
