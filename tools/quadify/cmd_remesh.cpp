@@ -519,13 +519,18 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
   if (small.stats.n_replaced > 0) {
     extracted.quads = std::move(small.quads);
-    if (!common.quiet)
+    if (!common.quiet) {
+      const size_t left_out = integer_map.stats.faces_with_unresolved_cones.size();
+      const std::string left_out_note =
+          left_out == 0 ? std::string()
+                        : "; " + std::to_string(left_out) +
+                              " triangles left out of the extraction for a cone of index 3 or more";
       std::fprintf(stderr,
                    "quadify: %s: %d component(s) too small for the quad grid became %d quads, three per "
-                   "input triangle (%d extracted faces that were not all quads removed; %zu triangles "
-                   "left out of the extraction for a cone of index 3 or more)\n",
+                   "input triangle (%d extracted faces that were not all quads removed%s)\n",
                    args.input.c_str(), small.stats.n_replaced, small.stats.n_quads_added,
-                   small.stats.n_faces_removed, integer_map.stats.faces_with_unresolved_cones.size());
+                   small.stats.n_faces_removed, left_out_note.c_str());
+    }
   }
   quadex::RelaxStats relax_stats;
   if (args.relax) {
