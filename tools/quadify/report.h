@@ -90,7 +90,7 @@ struct FeatureArgs {
   bool from_obj_lines = true;  // OBJ `l` lines of the input are feature edges too
   bool boundaries = true;    // boundaries are features (--no-boundary-alignment turns it off)
   double max_tau = 2.5;      // --feature-max-tau
-  double max_wedge_stretch = 1.8;  // --feature-max-wedge-stretch
+  double max_wedge_stretch = 1.95;  // --feature-max-wedge-stretch
   bool curve_labels = false;  // --feature-curve-labels: smooth feature curves labeled as one
   bool soft = false;         // --feature-mode after: Alg. 3 (param::FeatureMode::kAfterRounding)
 };
