@@ -66,9 +66,10 @@ constexpr double kJumpApart = 0.05;
 // and the relative gain in distance a quad's other split must bring for its vertex order to turn.
 constexpr int kDiagonalSamples = 6;
 constexpr double kDiagonalGain = 0.01;
-// Unfolding the quads still flipped after the repair (see its use): the vertex rings around them
-// that may move, and the raised thresholds tried in turn.
+// Unfolding the quads still flipped or slivers (worst corner below kSliver) after the repair (see
+// its use): the vertex rings around them that may move, and the raised thresholds tried in turn.
 constexpr int kUnfoldRings = 3;
+constexpr double kSliver = 0.05;
 constexpr double kUnfoldThresholds[] = {0.25, 0.3, 0.35};
 
 }  // namespace
@@ -647,39 +648,50 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   // Quads still flipped sit in a fold that no move of one vertex at a time opens at the
   // threshold (octopus at 5,000 quads: a tentacle tip curling up, thinner than a quad, where the
-  // worst quad around each vertex of the fold would get worse first). Around them
-  // (kUnfoldRings rings of vertices; the rest stays), the jumps and steps run again with raised
-  // thresholds, which move the fold's neighbours too; kept when fewer quads are flipped after.
-  // (Raising the threshold everywhere also unfolds it, but pulls quads off every thin tip.)
-  for (const double threshold : kUnfoldThresholds) {
-    const int flipped = count_bad(kFlipped);
-    if (flipped == 0) break;
-    std::vector<char> near(nv, 0);
-    for (int f = 0; f < nf; ++f)
-      if (q.degree(f) == 4 && quad_quality(f) < kFlipped)
-        for (int k = 0; k < 4; ++k) near[q.vertex(f, k)] = 1;
-    for (int ring = 0; ring < kUnfoldRings; ++ring) {
-      const std::vector<char> inner = near;
+  // worst quad around each vertex of the fold would get worse first); slivers (below kSliver)
+  // are the same kind of knot, one step short of a fold. Around them (kUnfoldRings rings of
+  // vertices; the rest stays), the vertices go back to their extracted positions and the jumps
+  // and steps run again with raised thresholds, which move the knot's neighbours too; kept when
+  // fewer quads are below the target after and no more are flipped. (Raising the threshold
+  // everywhere also unfolds it, but pulls quads off every thin tip.) `target`: kFlipped for the
+  // folds, first, with the vertices the last resort released; then kSliver for the slivers,
+  // with every vertex on a feature or boundary where it is (a crease keeps its quad edges).
+  auto unfold = [&](const std::vector<char>& frozen_mask, double target) {
+    for (const double threshold : kUnfoldThresholds) {
+      const int flipped = count_bad(kFlipped);
+      const int below = count_bad(target);
+      if (below == 0) break;
+      std::vector<char> near(nv, 0);
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4 && quad_quality(f) < target)
+          for (int k = 0; k < 4; ++k) near[q.vertex(f, k)] = 1;
+      for (int ring = 0; ring < kUnfoldRings; ++ring) {
+        const std::vector<char> inner = near;
+        for (int v = 0; v < nv; ++v)
+          if (inner[v])
+            for (const int w : neighbours[v]) near[w] = 1;
+      }
+      std::vector<char> local_frozen(nv);
+      for (int v = 0; v < nv; ++v) local_frozen[v] = frozen_mask[v] || !near[v];
+      const Eigen::MatrixX3d saved = q.V;
       for (int v = 0; v < nv; ++v)
-        if (inner[v])
-          for (const int w : neighbours[v]) near[w] = 1;
+        if (!local_frozen[v]) q.V.row(v) = quads.V.row(v);  // from the extracted positions
+      int jumps = jump_rounds(local_frozen, threshold);
+      const int moves = relax_rounds(local_frozen, threshold);
+      jumps += jump_rounds(local_frozen, threshold);
+      if (count_bad(kFlipped) <= flipped && count_bad(target) < below) {
+        res.stats.n_jumps += jumps;
+        res.stats.n_moves += moves;
+        res.stats.n_unfolded += below - count_bad(target);
+      } else {
+        q.V = saved;
+      }
     }
-    std::vector<char> local_frozen(nv);
-    for (int v = 0; v < nv; ++v) local_frozen[v] = frozen[v] || !near[v];
-    const Eigen::MatrixX3d saved = q.V;
-    for (int v = 0; v < nv; ++v)
-      if (!local_frozen[v]) q.V.row(v) = quads.V.row(v);  // from the extracted positions
-    int jumps = jump_rounds(local_frozen, threshold);
-    const int moves = relax_rounds(local_frozen, threshold);
-    jumps += jump_rounds(local_frozen, threshold);
-    if (count_bad(kFlipped) < flipped) {
-      res.stats.n_jumps += jumps;
-      res.stats.n_moves += moves;
-      res.stats.n_unfolded += flipped - count_bad(kFlipped);
-    } else {
-      q.V = saved;
-    }
-  }
+  };
+  unfold(frozen, kFlipped);
+  std::vector<char> strict_frozen(nv);
+  for (int v = 0; v < nv; ++v) strict_frozen[v] = fixed[v] || on_feature[v];
+  unfold(strict_frozen, kSliver);
   // The fitting measures the quads as they will be split, and may change which split is closer.
   if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(nullptr);
   if (options.fit_fraction > 0 && options.fit_rounds > 0) {

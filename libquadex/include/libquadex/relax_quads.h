@@ -41,8 +41,8 @@ struct RelaxOptions {
   // the curve: a flipped or flat quad is worse than a crease or boundary missed by a fraction of
   // a quad), as a last resort.
   bool release_features_for_flips = true;
-  // (Then, for quads still flipped: a local pass around them, from their extracted positions,
-  // with raised thresholds; see RelaxStats::n_unfolded.)
+  // (Then, for quads still flipped or below 0.05: a local pass around them, from their extracted
+  // positions, with raised thresholds; see RelaxStats::n_unfolded.)
   // Sample jumps, before the steps above (and again after them, and after the last resort for
   // the quads still flipped): a vertex of a quad below min_scaled_jacobian moves to a surface
   // sample (a vertex of the surface or a point inside one of its triangles) within jump_reach of
@@ -84,7 +84,9 @@ struct RelaxStats {
   int n_moves = 0;       // accepted vertex moves
   int n_jumps = 0;       // sample jumps (see jump_reach)
   int n_feature_vertices_moved = 0;  // vertices on features or boundaries moved by the last resort
-  int n_unfolded = 0;  // flipped quads repaired by the local pass with raised thresholds (a fold)
+  // Quads lifted from below 0.05 (flipped or slivers: a fold) by the local pass with raised
+  // thresholds.
+  int n_unfolded = 0;
   int n_snapped = 0;     // vertices moved onto a feature they were near (see snap_reach)
   int n_fitted = 0;      // moves of the shape fitting (see fit_fraction)
   int n_diagonals_turned = 0;  // quads that start at their next corner (see choose_diagonals)
