@@ -858,21 +858,24 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     std::vector<int> vertex_component(mesh.n_vertices(), -1);
     for (int k = 0; k < cl.n_copies(); ++k) vertex_component[cl.copy_vertex[k]] = cl.copy_component[k];
     std::vector<char> component_unresolved(cl.n_components, 0);
-    for (const param::ConeInfo& c : seamless.cones)
-      if (c.index >= 3 && component_quads[vertex_component[c.vertex]] < kMinQuadsForCones)
-        component_unresolved[vertex_component[c.vertex]] = 1;
+    for (const param::ConeInfo& c : seamless.cones) {
+      if (c.index < 3) continue;
+      const int comp = vertex_component[c.vertex];
+      if (component_quads[comp] < kMinQuadsForCones) {
+        component_unresolved[comp] = 1;
+        continue;
+      }
+      if (out.status.is_ok())  // the first such cone is named
+        out.status = core::Status::invalid_input(
+            "cone vertex " + std::to_string(c.vertex) + " has index " + std::to_string(c.index) + " (UV angle " +
+            std::to_string(90 * (4 - c.index)) + "°): no quad mesh has a vertex of valence " +
+            std::to_string(4 - c.index) + " (split such cones: param::ParamOptions::cone_split_distance)");
+    }
+    // Named also when the map is refused (the caller tells the refused cone from these).
     for (int f = 0; f < nf; ++f)
       if (component_unresolved[cl.copy_component[cl.corner_copy[3 * f]]])
         out.stats.faces_with_unresolved_cones.push_back(f);
-    for (const param::ConeInfo& c : seamless.cones)
-      if (c.index >= 3 && component_quads[vertex_component[c.vertex]] >= kMinQuadsForCones) {
-        out.status = core::Status::invalid_input(
-            "cone vertex " + std::to_string(c.vertex) + " has index " + std::to_string(c.index) + " (UV angle " +
-            std::to_string(90 * (4 - c.index)) +
-            "°): no quad mesh has a vertex of valence " + std::to_string(4 - c.index) +
-            " (split such cones: param::ParamOptions::cone_split_distance)");
-        return out;
-      }
+    if (!out.status.is_ok()) return out;
   }
   param::PinnedLayoutOptions lopt;
   lopt.energy = options.energy;
