@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <queue>
 #include <stdexcept>
 #include <string>
 
@@ -149,6 +150,76 @@ std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge
   smooth(core::vertex_neighbours(mesh), options.smoothing_passes, &log_size);
   std::vector<double> size(nv);
   for (int v = 0; v < nv; ++v) size[v] = std::exp(log_size[v]);
+  return size;
+}
+
+std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
+                                              const std::vector<std::array<int, 2>>& feature_edges,
+                                              double edge_length, const FeatureLoopSizingOptions& options) {
+  if (!(edge_length > 0) || !(options.min_loop_edges > 0) || !(options.min_ratio > 0) ||
+      !(options.min_ratio <= 1) || !(options.grade > 0))
+    throw std::invalid_argument("feature_loop_vertex_size: edge_length, min_loop_edges and grade > 0 and "
+                                "min_ratio in (0, 1] required");
+  const int nv = mesh.n_vertices();
+  std::vector<std::vector<int>> curve_nb(nv);
+  for (const auto& [a, b] : feature_edges) {
+    if (a < 0 || a >= nv || b < 0 || b >= nv)
+      throw std::invalid_argument("feature_loop_vertex_size: feature edge (" + std::to_string(a) + ", " +
+                                  std::to_string(b) + ") has a vertex out of range");
+    if (a == b) continue;
+    curve_nb[a].push_back(b);
+    curve_nb[b].push_back(a);
+  }
+  for (std::vector<int>& nb : curve_nb) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  auto point = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v); };
+  // Closed loops: connected sets of curve vertices that all lie on exactly two curve edges.
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  std::vector<double> size(nv, 1.0);
+  std::vector<char> seen(nv, 0);
+  for (int start = 0; start < nv; ++start) {
+    if (seen[start] || curve_nb[start].empty()) continue;
+    std::vector<int> loop = {start};
+    seen[start] = 1;
+    bool closed = true;
+    double length = 0;
+    for (size_t i = 0; i < loop.size(); ++i) {
+      const int v = loop[i];
+      if (curve_nb[v].size() != 2) closed = false;
+      for (const int w : curve_nb[v]) {
+        if (v < w) length += (point(w) - point(v)).norm();
+        if (!seen[w]) {
+          seen[w] = 1;
+          loop.push_back(w);
+        }
+      }
+    }
+    const double relative = length / (options.min_loop_edges * edge_length);
+    if (!closed || !(relative < 1)) continue;
+    for (const int v : loop) {
+      size[v] = std::max(options.min_ratio, relative);
+      queue.push({size[v], v});
+    }
+  }
+  // Multi-source Dijkstra: size(v) = min over sources c of size(c) + grade · d(v, c) / edge_length,
+  // d along mesh edges.
+  const std::vector<std::vector<int>> nb = core::vertex_neighbours(mesh);
+  const double per_length = options.grade / edge_length;
+  while (!queue.empty()) {
+    const auto [s, v] = queue.top();
+    queue.pop();
+    if (s > size[v]) continue;
+    for (const int w : nb[v]) {
+      const double sw = s + per_length * (point(w) - point(v)).norm();
+      if (sw < size[w]) {
+        size[w] = sw;
+        queue.push({sw, w});
+      }
+    }
+  }
   return size;
 }
 

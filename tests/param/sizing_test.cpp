@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -137,6 +138,52 @@ TEST(Sizing, ThinPartSizesShrinkWhereTheRadiusIsBelowAQuadEdge) {
   }
   EXPECT_NEAR(sized, area, 1e-9 * area);
   EXPECT_THROW((void)thin_part_vertex_size(e, 0.0), std::invalid_argument);
+}
+
+TEST(Sizing, ShortClosedFeatureLoopsGetSmallerQuads) {
+  // The link of vertex 0 of the unit icosphere: a closed loop of feature edges around it.
+  const core::TriMesh m = data_mesh("sphere.obj");
+  std::vector<int> ring;
+  for (int f = 0; f < m.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (m.F(f, k) == 0) ring.push_back(f);
+  std::vector<std::array<int, 2>> loop;
+  double length = 0;
+  for (const int f : ring) {
+    int k = 0;
+    while (m.F(f, k) != 0) ++k;
+    const int a = m.F(f, (k + 1) % 3), b = m.F(f, (k + 2) % 3);
+    loop.push_back({a, b});
+    length += (m.V.row(a) - m.V.row(b)).norm();
+  }
+  ASSERT_GE(loop.size(), 5u);
+  FeatureLoopSizingOptions o;
+  // Quads of edge C / 6: the loop wants 12 around, it gets 6 → half the edge along it.
+  const double edge = length / 6;
+  const std::vector<double> s = feature_loop_vertex_size(m, loop, edge, o);
+  ASSERT_EQ(static_cast<int>(s.size()), m.n_vertices());
+  for (const auto& [a, b] : loop) EXPECT_NEAR(s[a], 0.5, 1e-12) << "loop vertex " << a;
+  // Growing back by `grade` per target edge of distance: the centre is within one mesh edge.
+  const double centre_distance = (m.V.row(0) - m.V.row(loop[0][0])).norm();
+  EXPECT_GT(s[0], 0.5);
+  EXPECT_LE(s[0], 0.5 + o.grade * centre_distance / edge + 1e-12);
+  int far = -1;
+  for (int v = 0; v < m.n_vertices(); ++v) {
+    EXPECT_GE(s[v], 0.5 - 1e-12) << v;
+    EXPECT_LE(s[v], 1.0) << v;
+    if (m.V.row(v).dot(m.V.row(0)) < -0.9) far = v;
+  }
+  ASSERT_GE(far, 0);
+  EXPECT_EQ(s[far], 1.0) << "the antipode is far from the loop";
+  // The floor, with coarse quads.
+  for (const double x : feature_loop_vertex_size(m, loop, 100 * length, o)) EXPECT_GE(x, o.min_ratio - 1e-12);
+  EXPECT_NEAR(feature_loop_vertex_size(m, loop, 100 * length, o)[loop[0][0]], o.min_ratio, 1e-12);
+  // A loop already 12 quad edges around, and an open curve, leave the size alone.
+  for (const double x : feature_loop_vertex_size(m, loop, length / 12, o)) EXPECT_EQ(x, 1.0);
+  const std::vector<std::array<int, 2>> open(loop.begin() + 1, loop.end());
+  for (const double x : feature_loop_vertex_size(m, open, edge, o)) EXPECT_EQ(x, 1.0);
+  EXPECT_THROW((void)feature_loop_vertex_size(m, loop, 0.0), std::invalid_argument);
+  EXPECT_THROW((void)feature_loop_vertex_size(m, {{0, m.n_vertices()}}, edge), std::invalid_argument);
 }
 
 TEST(Sizing, AnisotropicMetricIsLongerAlongTheDirectionOfLesserCurvature) {

@@ -34,6 +34,7 @@ struct RemeshArgs {
   bool feature_snap = true;
   bool fit = true;
   bool thin_parts = true;  // retry a dead end with thin-part sizing (param::thin_part_vertex_size)
+  bool feature_sizing = true;  // smaller quads around short closed feature curves (param::feature_loop_vertex_size)
   param::ParamOptions param;
   int samples = 100'000;
   double cone_pair_distance = 4;  // × the target quad edge length
@@ -203,6 +204,29 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     param_options.feature_edges = quantize::features_for_density(mesh, param_options.feature_edges, quantize_options);
     feature_input.n_too_small = static_cast<int>(before - param_options.feature_edges.size());
   }
+  // Feature-loop sizing: without sizes of the user's, quads shrink around closed feature curves
+  // too short for 12 quad edges, small holes' rims (param::feature_loop_vertex_size; the count
+  // stays).
+  std::vector<double> curve_size;
+  if (args.feature_sizing && sizing.face_size.empty() && sizing.face_metric.empty() &&
+      !param_options.feature_edges.empty()) {
+    curve_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
+    const double smallest = *std::min_element(curve_size.begin(), curve_size.end());
+    if (smallest < 1) {
+      sizing.face_size = param::face_size_from_vertices(mesh, curve_size);
+      const auto [lo, hi] = std::minmax_element(sizing.face_size.begin(), sizing.face_size.end());
+      sizing.report = {{"mode", "feature-loops"},
+                       {"smallest_relative_edge", number(smallest)},
+                       {"sized_vertices", std::count_if(curve_size.begin(), curve_size.end(),
+                                                        [](double s) { return s < 1; })},
+                       {"min", number(*lo)},
+                       {"max", number(*hi)}};
+      sizing.apply_to(&param_options);
+      quantize_options.face_size = sizing.face_size;
+    } else {
+      curve_size.clear();
+    }
+  }
   // The report's param and quantize sections, written as soon as a stage has run.
   int fine_cones = -1;  // the feature-free map's cones, when coarse cones replaced it
   std::string coarse_reason;
@@ -328,7 +352,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   quantize_options.feature_time_budget_seconds =
       std::max(kMinFeatureSeconds, kFeatureTimeFactor * seamless.stats.seconds_total);
   // Thin parts (see the retry below): the field, computed at the first dead end that needs it.
-  const bool thin_retry_allowed = args.thin_parts && sizing.face_size.empty() && sizing.face_metric.empty();
+  const bool thin_retry_allowed =
+      args.thin_parts && (sizing.face_size.empty() || !curve_size.empty()) && sizing.face_metric.empty();
   std::vector<double> thin;
   auto thin_field = [&]() -> const std::vector<double>& {
     if (thin.empty()) thin = param::thin_part_vertex_size(mesh, quad_edge);
@@ -404,8 +429,10 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      "the quads (radius of curvature below a quad edge): parametrizing again with quads "
                      "down to %.2f times as long there\n",
                      args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
-      sizing.face_size = param::face_size_from_vertices(mesh, thin);
-      sizing.report = {{"mode", "thin-parts"},
+      std::vector<double> sizes = thin;  // with the feature-loop sizes, where smaller
+      for (size_t v = 0; v < curve_size.size(); ++v) sizes[v] = std::min(sizes[v], curve_size[v]);
+      sizing.face_size = param::face_size_from_vertices(mesh, sizes);
+      sizing.report = {{"mode", curve_size.empty() ? "thin-parts" : "thin-parts+feature-loops"},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
                        {"thin_area_share", number(thin_area / area)}};
@@ -703,6 +730,12 @@ CommandRunner register_remesh(CLI::App& app) {
                "than a quad (by default, without --adaptive or --size-field: quads down to a quarter of "
                "the target edge where the radius of curvature is below it, the count kept; sizing.mode "
                "\"thin-parts\" in the report)");
+  app.add_flag("!--no-feature-sizing", args->feature_sizing,
+               "Keep the quad size uniform around short closed feature curves (by default, without "
+               "--adaptive or --size-field: a closed crease or boundary loop less than 12 target quad "
+               "edges long, such as a small hole's rim, gets 12 quads around, down to 0.3 of the target "
+               "edge, growing back by a quarter per quad edge; the count kept; sizing.mode "
+               "\"feature-loops\" in the report)");
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "
