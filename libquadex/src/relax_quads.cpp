@@ -40,6 +40,11 @@ constexpr double kOnFeature = 1e-9;
 // A feature point within this (× the mean quad edge length around a vertex) of one of the
 // vertex's quad edges is met by the quads already: no snapping there.
 constexpr double kSnapCovered = 0.02;
+// A snap may take a vertex's quads farther from the surface, up to this share of the largest
+// distance of any quad before snapping (casting at 5,000 quads: snaps that made no such check
+// raised the Hausdorff distance 0.0065 -> 0.0090; teapot lost 2% of its feature capture when
+// none could).
+constexpr double kSnapDistanceShare = 0.75;
 // Fraction of the way to the neighbour centroid tried after the full step is refused.
 constexpr double kHalfStep = 0.5;
 // Fractions of the way to the centroid of a bad quad the vertex belongs to, tried next.
@@ -349,34 +354,6 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     }
     return total;
   };
-  // Moves vertex v onto the closest point p of the features when p is within snap_reach of v's
-  // mean quad edge, no quad edge around v passes by p already, and every quad around v keeps its
-  // quality or stays at least snap_min_quality (see RelaxOptions::snap_reach); true if it moved.
-  auto snap_onto_feature = [&](int v) {
-    const Eigen::Vector3d old = q.V.row(v).transpose();
-    const double h = mean_edge(v);
-    const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
-    const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
-    if (!((p - old).norm() <= options.snap_reach * h)) return false;
-    double covered = std::numeric_limits<double>::infinity();
-    for (int f : vertex_quads[v])
-      for (int k = 0; k < 4; ++k) {
-        const Eigen::Vector3d a = q.V.row(q.vertex(f, k)).transpose();
-        const Eigen::Vector3d b = q.V.row(q.vertex(f, (k + 1) % 4)).transpose();
-        const Eigen::Vector3d ab = b - a;
-        const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-        covered = std::min(covered, (a + t * ab - p).norm());
-      }
-    if (covered <= kSnapCovered * h) return false;
-    std::vector<double> before;
-    for (int f : vertex_quads[v]) before.push_back(quad_quality(f));
-    q.V.row(v) = p.transpose();
-    bool keep = true;
-    for (size_t i = 0; i < before.size() && keep; ++i)
-      keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
-    if (!keep) q.V.row(v) = old.transpose();
-    return keep;
-  };
   // Shape fitting (see RelaxOptions::fit_fraction). The quads are measured as two triangles each,
   // (0,1,2) and (0,2,3), as core::to_trimesh and the metrics split them. Surface samples (the
   // vertices and three interior points per triangle) are owned by their closest face at the start
@@ -406,6 +383,43 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         }
     }
     return std::sqrt(worst);
+  };
+  // Distance from the surface up to which a snap may take a vertex's quads (set below).
+  double snap_distance_allowed = 0;
+  // Moves vertex v onto the closest point p of the features when p is within snap_reach of v's
+  // mean quad edge, no quad edge around v passes by p already, every quad around v keeps its
+  // quality or stays at least snap_min_quality, and its quads get no farther from the surface
+  // (see RelaxOptions::snap_reach); true if it moved.
+  auto snap_onto_feature = [&](int v) {
+    const Eigen::Vector3d old = q.V.row(v).transpose();
+    const double h = mean_edge(v);
+    const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
+    const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
+    if (!((p - old).norm() <= options.snap_reach * h)) return false;
+    double covered = std::numeric_limits<double>::infinity();
+    for (int f : vertex_quads[v])
+      for (int k = 0; k < 4; ++k) {
+        const Eigen::Vector3d a = q.V.row(q.vertex(f, k)).transpose();
+        const Eigen::Vector3d b = q.V.row(q.vertex(f, (k + 1) % 4)).transpose();
+        const Eigen::Vector3d ab = b - a;
+        const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+        covered = std::min(covered, (a + t * ab - p).norm());
+      }
+    if (covered <= kSnapCovered * h) return false;
+    std::vector<double> before;
+    double distance_before = 0;
+    for (int f : vertex_quads[v]) {
+      before.push_back(quad_quality(f));
+      distance_before = std::max(distance_before, quad_distance(f));
+    }
+    q.V.row(v) = p.transpose();
+    bool keep = true;
+    for (size_t i = 0; i < before.size() && keep; ++i)
+      keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
+    for (size_t i = 0; i < before.size() && keep; ++i)
+      keep = quad_distance(vertex_quads[v][i]) <= std::max(distance_before, snap_distance_allowed);
+    if (!keep) q.V.row(v) = old.transpose();
+    return keep;
   };
   // Each surface sample's closest face (owner, -1 when there is no face) and its distance to it,
   // the faces split as the metrics split them; false when there is no face.
@@ -612,6 +626,9 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     if (q.degree(f) != 4)
       for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
   if (feature_tree && options.snap_reach > 0) {
+    for (int f = 0; f < nf; ++f)
+      if (q.degree(f) == 4) snap_distance_allowed = std::max(snap_distance_allowed, quad_distance(f));
+    snap_distance_allowed *= kSnapDistanceShare;
     for (int v = 0; v < nv; ++v) {
       if (fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v]) continue;
       if (snap_onto_feature(v)) {
