@@ -134,8 +134,8 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   }
   for (int v = 0; v < nv; ++v)
     if (vertex_quads[v].empty()) fixed[v] = 1;
-  std::vector<Segment> segments;
-  std::optional<SegmentTree> feature_tree;
+  std::vector<Segment> segments, snap_segments;
+  std::optional<SegmentTree> feature_tree, snap_tree;
   if (!options.feature_edges.empty()) {
     for (const auto& [a, b] : options.feature_edges) {
       if (a < 0 || b < 0 || a >= surface.n_vertices() || b >= surface.n_vertices()) {
@@ -144,6 +144,25 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       }
       const Eigen::Vector3d pa = surface.V.row(a), pb = surface.V.row(b);
       if (pa != pb) segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
+    }
+    // Snapping aims at creases only: an interior vertex moved onto the surface's boundary makes
+    // a quad fold against it (camelhead at 5,000 quads with the reach at 0.75: Hausdorff 0.0047
+    // -> 0.0054, worst corner 0.21 -> 0.06).
+    std::map<std::pair<int, int>, int> surface_edge_faces;
+    for (int f = 0; f < surface.n_faces(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const int a = surface.F(f, k), b = surface.F(f, (k + 1) % 3);
+        ++surface_edge_faces[{std::min(a, b), std::max(a, b)}];
+      }
+    for (const auto& [a, b] : options.feature_edges) {
+      const auto it = surface_edge_faces.find({std::min(a, b), std::max(a, b)});
+      if (it != surface_edge_faces.end() && it->second == 1) continue;
+      const Eigen::Vector3d pa = surface.V.row(a), pb = surface.V.row(b);
+      if (pa != pb) snap_segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
+    }
+    if (!snap_segments.empty()) {
+      snap_tree.emplace(snap_segments.begin(), snap_segments.end());
+      snap_tree->accelerate_distance_queries();
     }
     if (!segments.empty()) {
       feature_tree.emplace(segments.begin(), segments.end());
@@ -393,7 +412,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   auto snap_onto_feature = [&](int v) {
     const Eigen::Vector3d old = q.V.row(v).transpose();
     const double h = mean_edge(v);
-    const Point cp = feature_tree->closest_point(Point(old.x(), old.y(), old.z()));
+    const Point cp = snap_tree->closest_point(Point(old.x(), old.y(), old.z()));
     const Eigen::Vector3d p(cp.x(), cp.y(), cp.z());
     if (!((p - old).norm() <= options.snap_reach * h)) return false;
     double covered = std::numeric_limits<double>::infinity();
@@ -625,7 +644,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   for (int f = 0; f < nf; ++f)
     if (q.degree(f) != 4)
       for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
-  if (feature_tree && options.snap_reach > 0) {
+  if (snap_tree && options.snap_reach > 0) {
     for (int f = 0; f < nf; ++f)
       if (q.degree(f) == 4) snap_distance_allowed = std::max(snap_distance_allowed, quad_distance(f));
     snap_distance_allowed *= kSnapDistanceShare;

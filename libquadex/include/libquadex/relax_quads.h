@@ -27,19 +27,19 @@ struct RelaxOptions {
   // bounding-box diagonal) stay fixed, so that feature curves keep their quad-edge chains
   // (but see release_features_for_flips).
   std::vector<std::array<int, 2>> feature_edges;
-  // Snapping to features missed by the quads: a vertex (not on a feature or boundary, and only
-  // of quads) whose
-  // closest feature point p lies within snap_reach of its mean quad edge length, where the quads
-  // around it do not already have p on one of their edges (a crease crossing a quad or running
-  // beside a chain of quad edges), moves onto p, if every quad around it keeps a worst corner
-  // of at least snap_min_quality (or does not get worse) and gets no farther from the surface
-  // than it was or than 0.75 of the largest distance of any quad. A crease missed by a row of
-  // quads (a disabled or released feature edge, a label switch) is then cut by them only between
-  // snapped vertices, instead of being cut off by up to half a quad. 0 = off. (0.5 and 0.1 until
+  // Snapping to creases missed by the quads: a vertex (not on a feature or boundary, and only
+  // of quads) whose closest point p on a feature edge that is not on the surface's boundary lies
+  // within snap_reach of its mean quad edge length, where the quads around it do not already
+  // have p on one of their edges (a crease crossing a quad or running beside a chain of quad
+  // edges), moves onto p, if every quad around it keeps a worst corner of at least
+  // snap_min_quality (or does not get worse) and gets no farther from the surface than it was
+  // or than 0.75 of the largest distance of any quad. A crease missed by a row of quads (a
+  // disabled or released feature edge, a label switch) is then cut by them only between snapped
+  // vertices, instead of being cut off by up to half a quad. 0 = off. (Reach 0.5 until
   // 2026-12-05: fandisk's Hausdorff 0.0035 -> 0.0031 and feature capture 0.984 -> 0.986, block
-  // 0.944 -> 0.950, wingnut 0.935 -> 0.948 at 5,000 quads.)
+  // 0.944 -> 0.949, wingnut 0.935 -> 0.945 at 5,000 quads.)
   double snap_reach = 0.75;
-  double snap_min_quality = 0.05;
+  double snap_min_quality = 0.1;
   // Quads still flipped after that may move their vertices on features and boundaries too (off
   // the curve: a flipped or flat quad is worse than a crease or boundary missed by a fraction of
   // a quad), as a last resort.
