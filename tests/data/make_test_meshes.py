@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes the small clean test meshes of tests/data (stdlib only, deterministic):
 tet.obj, cube.obj (12 triangles), sphere.obj (icosphere, 1280 triangles), disk.obj (open,
-200 triangles), torus.obj (800 triangles), box.obj, plate.obj (genus 5, sharp hole walls).
+200 triangles), torus.obj (800 triangles), box.obj, plate.obj (genus 5, sharp hole walls),
+washer.obj (genus 1, four sharp circular rims).
 spot.obj is copied from examples/data."""
 import math
 import os
@@ -172,6 +173,36 @@ def torus(n=20, m=20, R=1.0, r=0.35):
     return v, f
 
 
+def washer(r_in=0.1, r_out=0.5, thickness=0.1, rings=8, sectors=40, wall_layers=2):
+    """Flat ring r_in..r_out of `thickness`: a closed genus-1 solid with four sharp circular rims
+    (the inner two short: a small hole's rims)."""
+    index = {}
+    v, f = [], []
+
+    def vid(i, k, j):
+        key = (i, k, j % sectors)
+        if key not in index:
+            r = r_in + (r_out - r_in) * i / rings
+            a = 2 * math.pi * (j % sectors) / sectors
+            index[key] = len(v)
+            v.append((r * math.cos(a), r * math.sin(a), thickness * k / wall_layers))
+        return index[key]
+
+    def quad(q):
+        f.extend([(q[0], q[1], q[2]), (q[0], q[2], q[3])])
+
+    for j in range(sectors):
+        for i in range(rings):
+            top = [vid(i, wall_layers, j), vid(i + 1, wall_layers, j), vid(i + 1, wall_layers, j + 1),
+                   vid(i, wall_layers, j + 1)]
+            quad(top)
+            quad([vid(i, 0, j), vid(i, 0, j + 1), vid(i + 1, 0, j + 1), vid(i + 1, 0, j)])
+        for k in range(wall_layers):
+            quad([vid(rings, k, j), vid(rings, k, j + 1), vid(rings, k + 1, j + 1), vid(rings, k + 1, j)])
+            quad([vid(0, k, j), vid(0, k + 1, j), vid(0, k + 1, j + 1), vid(0, k, j + 1)])
+    return v, f
+
+
 if __name__ == "__main__":
     write_obj("tet.obj", *tet(), "regular tetrahedron, genus 0")
     write_obj("cube.obj", *cube(), "unit cube, 12 triangles, genus 0")
@@ -180,3 +211,4 @@ if __name__ == "__main__":
     write_obj("disk.obj", *disk(), "open disk, 198 triangles, 1 boundary loop")
     write_obj("torus.obj", *torus(), "torus 20x20, 800 triangles, genus 1")
     write_obj("plate.obj", *plate(), "plate 1 x 1 x 0.1 with 5 square holes, genus 5, sharp edges")
+    write_obj("washer.obj", *washer(), "ring 0.1..0.5 x 0.1, 1600 triangles, genus 1, 4 sharp circular rims")

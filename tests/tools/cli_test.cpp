@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -580,6 +581,47 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   const Shape anisotropic = remesh("--adaptive --anisotropic");
   EXPECT_GT(anisotropic.along_over_around, 1.4) << "along/around " << anisotropic.along_over_around;
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["param"]["sizing"]["mode"], "adaptive-anisotropic");
+}
+
+// Feature-loop sizing: the washer's inner rims (circles of radius 0.1, 0.63 long) are about
+// 8 quad edges around at 300 quads; by default the remesher gives them about 12, and
+// --no-feature-sizing keeps the size uniform.
+TEST_F(CliTest, RemeshGivesShortFeatureLoopsMoreQuads) {
+  const std::string washer = data_path("washer.obj").string();
+  auto remesh = [&](const std::string& extra) {
+    const fs::path out = dir_ / "q.obj";
+    std::string args;
+    args.append("'").append(washer).append("' -o '").append(out.string());
+    args.append("' --target-faces 300 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
+    args.append(extra);
+    const CliRun r = quadify(args, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    EXPECT_EQ(report["quads"]["non_quads"], 0);
+    EXPECT_EQ(report["quads"]["flipped_quads"], 0);
+    EXPECT_EQ(report["quads"]["manifold"], true);
+    EXPECT_EQ(report["quads"]["genus"], 1);
+    EXPECT_NEAR(report["quads"]["faces"].get<int>(), 300, 30) << "the count stays near the target";
+    // Quad vertices on the inner top rim (r = 0.1, z = 0.1).
+    int on_rim = 0;
+    std::istringstream qs(slurp(out));
+    for (std::string line; std::getline(qs, line);) {
+      if (line.rfind("v ", 0) != 0) continue;
+      std::istringstream ls(line.substr(2));
+      Eigen::Vector3d p;
+      ls >> p.x() >> p.y() >> p.z();
+      if (std::abs(std::hypot(p.x(), p.y()) - 0.1) < 1e-3 && std::abs(p.z() - 0.1) < 1e-9) ++on_rim;
+    }
+    return std::make_pair(on_rim, report["param"]["sizing"]);
+  };
+  const auto [sized_rim, sized] = remesh("");
+  EXPECT_EQ(sized["mode"], "feature-loops");
+  EXPECT_GT(sized["sized_vertices"].get<int>(), 0);
+  EXPECT_NEAR(sized["smallest_relative_edge"].get<double>(), 0.66, 0.1) << "about 8 of the 12 edges wanted";
+  const auto [uniform_rim, uniform] = remesh("--no-feature-sizing");
+  EXPECT_EQ(uniform["mode"], "uniform");
+  EXPECT_GE(sized_rim, 11) << "quad vertices around the small hole's rim";
+  EXPECT_GT(sized_rim, uniform_rim + 2) << "with " << sized_rim << ", without " << uniform_rim;
 }
 
 // --align-curvature (paper 6.1): around the middle of the ellipsoid the quad edges follow the
