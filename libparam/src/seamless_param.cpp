@@ -98,13 +98,14 @@ constexpr double kMaxCancellationAngleLoss = 0.5;
 // split's path.
 constexpr int kConeSplitPasses = 4;
 constexpr int kConeSplitHops = 64;
-// A cancellation may raise the map's τ to at most max(floor, growth × τ before the pass).
 // A face the move into a batch's constraints squashes to a sliver passes the exact orientation
-// test but leaves no room to the optimizer or the quantization (casting with feature-curve
-// sizing at 4,500 quads: τ 3·10⁷ after the last batch, with σ1/σ2 of 10¹⁴ on two faces by an
+// test but leaves no room to the optimizer or the quantization (casting with a feature size
+// field at 4,500 quads: τ 3·10⁷ after the last batch, with σ1/σ2 of 10¹⁴ on two faces by an
 // aligned crease edge). Faces whose singular values differ by more than this factor count as
-// flipped in a batch's repairs; the optimizer leaves below 10 on every benchmark mesh.
+// flipped in a batch's repairs; the optimizer leaves τ below 10 (σ1/σ2 below 100) on every
+// benchmark mesh.
 constexpr double kSliverStretch = 1e4;
+// A cancellation may raise the map's τ to at most max(floor, growth × τ before the pass).
 constexpr double kCancellationTauFloor = 5;
 constexpr double kCancellationTauGrowth = 2;
 // Penalty stages of a cancellation's move into its constraints (w = 1e3 … 1e5): a set that needs
@@ -1210,4 +1211,3 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
 }
 
 }  // namespace quadify::param
-

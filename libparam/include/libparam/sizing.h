@@ -51,10 +51,10 @@ struct ThinPartSizingOptions {
 [[nodiscard]] std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge_length,
                                                         const ThinPartSizingOptions& options = {});
 
-// Feature-loop sizing: a closed feature curve (a hole's rim, a boss's edge) only a few quad
-// edges around is cut off by their chords, by up to a quarter of its radius: casting at 5,000
-// quads has holes of radius 1.2 quad edges rimmed by 6–8 chords that miss the crease by up to
-// 1% of the diagonal. A closed loop of length C shorter than min_loop_edges target edges gets
+// Feature-loop sizing: a closed feature curve (a hole's rim, a boss's edge) only n quad edges
+// around is cut off by their chords, by R·(1 − cos(π/n)) for a circle of radius R: casting at
+// 5,000 quads has holes of radius 1.2 quad edges rimmed by 6–8 chords that miss the crease by up
+// to 1% of the diagonal. A closed loop of length C shorter than min_loop_edges target edges gets
 // quads of relative edge length C / (min_loop_edges · edge_length) (at least min_ratio) along
 // it, growing back to 1 by `grade` per target edge of distance along the mesh edges.
 struct FeatureLoopSizingOptions {
