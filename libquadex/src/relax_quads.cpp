@@ -137,14 +137,6 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   std::vector<Segment> segments, snap_segments;
   std::optional<SegmentTree> feature_tree, snap_tree;
   if (!options.feature_edges.empty()) {
-    for (const auto& [a, b] : options.feature_edges) {
-      if (a < 0 || b < 0 || a >= surface.n_vertices() || b >= surface.n_vertices()) {
-        res.status = core::Status::invalid_input("relax: feature edge vertex out of range");
-        return res;
-      }
-      const Eigen::Vector3d pa = surface.V.row(a), pb = surface.V.row(b);
-      if (pa != pb) segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
-    }
     // Snapping aims at creases only: an interior vertex moved onto the surface's boundary makes
     // a quad fold against it (camelhead at 5,000 quads with the reach at 0.75: Hausdorff 0.0047
     // -> 0.0054, worst corner 0.21 -> 0.06).
@@ -155,10 +147,15 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         ++surface_edge_faces[{std::min(a, b), std::max(a, b)}];
       }
     for (const auto& [a, b] : options.feature_edges) {
-      const auto it = surface_edge_faces.find({std::min(a, b), std::max(a, b)});
-      if (it != surface_edge_faces.end() && it->second == 1) continue;
+      if (a < 0 || b < 0 || a >= surface.n_vertices() || b >= surface.n_vertices()) {
+        res.status = core::Status::invalid_input("relax: feature edge vertex out of range");
+        return res;
+      }
       const Eigen::Vector3d pa = surface.V.row(a), pb = surface.V.row(b);
-      if (pa != pb) snap_segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
+      if (pa == pb) continue;
+      segments.emplace_back(Point(pa.x(), pa.y(), pa.z()), Point(pb.x(), pb.y(), pb.z()));
+      const auto it = surface_edge_faces.find({std::min(a, b), std::max(a, b)});
+      if (it == surface_edge_faces.end() || it->second != 1) snap_segments.push_back(segments.back());
     }
     if (!snap_segments.empty()) {
       snap_tree.emplace(snap_segments.begin(), snap_segments.end());
@@ -715,10 +712,11 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       int jumps = jump_rounds(local_frozen, threshold);
       const int moves = relax_rounds(local_frozen, threshold);
       jumps += jump_rounds(local_frozen, threshold);
-      if (count_bad(kFlipped) <= flipped && count_bad(target) < below) {
+      const int below_after = count_bad(target);
+      if (count_bad(kFlipped) <= flipped && below_after < below) {
         res.stats.n_jumps += jumps;
         res.stats.n_moves += moves;
-        res.stats.n_unfolded += below - count_bad(target);
+        res.stats.n_unfolded += below - below_after;
       } else {
         q.V = saved;
       }

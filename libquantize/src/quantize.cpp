@@ -216,14 +216,11 @@ class Rounder {
     if (!status_.is_ok()) return Outcome::kFailed;
     // A dead end on a cone or a translation comes from the alignment rows in the way: those
     // near it are released and the stage goes on.
+    // The feature lines go before the translations, or after them with features_last_.
     Outcome outcome = with_release([this] { return round_cones(); });
-    if (features_last_) {
-      if (outcome == Outcome::kDone) outcome = with_release([this] { return round_others(); });
-      if (outcome == Outcome::kDone) outcome = round_features();
-    } else {
-      if (outcome == Outcome::kDone) outcome = round_features();
-      if (outcome == Outcome::kDone) outcome = with_release([this] { return round_others(); });
-    }
+    if (outcome == Outcome::kDone && !features_last_) outcome = round_features();
+    if (outcome == Outcome::kDone) outcome = with_release([this] { return round_others(); });
+    if (outcome == Outcome::kDone && features_last_) outcome = round_features();
     stats_->seconds_rounding += seconds_since(tc);
     if (outcome != Outcome::kDone) return outcome;
     tc = Clock::now();

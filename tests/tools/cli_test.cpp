@@ -98,6 +98,17 @@ class CliTest : public ::testing::Test {
     std::error_code ec;
     if (!dir_.empty()) fs::remove_all(dir_, ec);
   }
+  // `quadify IN -o dir_/q.obj --target-faces N --quiet --json dir_/r.json EXTRA`: expects exit 0
+  // and returns the report.
+  nlohmann::json remesh_report(const fs::path& in, int target_faces, const std::string& extra) {
+    std::string args;
+    args.append("'").append(in.string()).append("' -o '").append((dir_ / "q.obj").string());
+    args.append("' --target-faces ").append(std::to_string(target_faces));
+    args.append(" --quiet --json '").append((dir_ / "r.json").string()).append("' ").append(extra);
+    const CliRun r = quadify(args, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return nlohmann::json::parse(slurp(dir_ / "r.json"));
+  }
   fs::path dir_;
 };
 
@@ -522,13 +533,7 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   };
   auto remesh = [&](const std::string& extra) {
     const fs::path out = dir_ / "q.obj";
-    std::string args;
-    args.append("'").append(in.string()).append("' -o '").append(out.string());
-    args.append("' --target-faces 600 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
-    args.append(extra);
-    const CliRun r = quadify(args, dir_);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    const auto report = remesh_report(in, 600, extra);
     EXPECT_EQ(report["quads"]["non_quads"], 0);
     EXPECT_EQ(report["quads"]["flipped_quads"], 0);
     EXPECT_NEAR(report["quads"]["faces"].get<int>(), 600, 60) << "the count stays near the target";
@@ -587,16 +592,9 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
 // 8 quad edges around at 300 quads; by default the remesher gives them about 12, and
 // --no-feature-sizing keeps the size uniform.
 TEST_F(CliTest, RemeshGivesShortFeatureLoopsMoreQuads) {
-  const std::string washer = data_path("washer.obj").string();
   auto remesh = [&](const std::string& extra) {
     const fs::path out = dir_ / "q.obj";
-    std::string args;
-    args.append("'").append(washer).append("' -o '").append(out.string());
-    args.append("' --target-faces 300 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
-    args.append(extra);
-    const CliRun r = quadify(args, dir_);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    const auto report = remesh_report(data_path("washer.obj"), 300, extra);
     EXPECT_EQ(report["quads"]["non_quads"], 0);
     EXPECT_EQ(report["quads"]["flipped_quads"], 0);
     EXPECT_EQ(report["quads"]["manifold"], true);
@@ -630,12 +628,7 @@ TEST_F(CliTest, CurvatureAlignmentTurnsQuadsOntoPrincipalDirections) {
   const fs::path in = dir_ / "ellipsoid.obj";
   write_ellipsoid(in);
   auto remesh = [&](const std::string& extra) {
-    std::string args;
-    args.append("'").append(in.string()).append("' -o '").append((dir_ / "q.obj").string());
-    args.append("' --target-faces 600 --quiet --json '").append((dir_ / "r.json").string()).append("' ");
-    const CliRun r = quadify(args + extra, dir_);
-    EXPECT_EQ(r.exit_code, 0) << r.err;
-    const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
+    const auto report = remesh_report(in, 600, extra);
     EXPECT_EQ(report["quads"]["non_quads"], 0);
     EXPECT_EQ(report["quads"]["flipped_quads"], 0);
     EXPECT_GT(report["quads"]["anisotropic_quads"].get<int>(), 100);

@@ -207,24 +207,24 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // Feature-loop sizing: without sizes of the user's, quads shrink around closed feature curves
   // too short for 12 quad edges, small holes' rims (param::feature_loop_vertex_size; the count
   // stays).
-  std::vector<double> curve_size;
+  std::vector<double> loop_size;
   if (args.feature_sizing && sizing.face_size.empty() && sizing.face_metric.empty() &&
       !param_options.feature_edges.empty()) {
-    curve_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
-    const double smallest = *std::min_element(curve_size.begin(), curve_size.end());
+    loop_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
+    const double smallest = *std::min_element(loop_size.begin(), loop_size.end());
     if (smallest < 1) {
-      sizing.face_size = param::face_size_from_vertices(mesh, curve_size);
+      sizing.face_size = param::face_size_from_vertices(mesh, loop_size);
       const auto [lo, hi] = std::minmax_element(sizing.face_size.begin(), sizing.face_size.end());
       sizing.report = {{"mode", "feature-loops"},
                        {"smallest_relative_edge", number(smallest)},
-                       {"sized_vertices", std::count_if(curve_size.begin(), curve_size.end(),
+                       {"sized_vertices", std::count_if(loop_size.begin(), loop_size.end(),
                                                         [](double s) { return s < 1; })},
                        {"min", number(*lo)},
                        {"max", number(*hi)}};
       sizing.apply_to(&param_options);
       quantize_options.face_size = sizing.face_size;
     } else {
-      curve_size.clear();
+      loop_size.clear();
     }
   }
   // The report's param and quantize sections, written as soon as a stage has run.
@@ -353,7 +353,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       std::max(kMinFeatureSeconds, kFeatureTimeFactor * seamless.stats.seconds_total);
   // Thin parts (see the retry below): the field, computed at the first dead end that needs it.
   const bool thin_retry_allowed =
-      args.thin_parts && (sizing.face_size.empty() || !curve_size.empty()) && sizing.face_metric.empty();
+      args.thin_parts && (sizing.face_size.empty() || !loop_size.empty()) && sizing.face_metric.empty();
   std::vector<double> thin;
   auto thin_field = [&]() -> const std::vector<double>& {
     if (thin.empty()) thin = param::thin_part_vertex_size(mesh, quad_edge);
@@ -430,9 +430,9 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      "down to %.2f times as long there\n",
                      args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
       std::vector<double> sizes = thin;  // with the feature-loop sizes, where smaller
-      for (size_t v = 0; v < curve_size.size(); ++v) sizes[v] = std::min(sizes[v], curve_size[v]);
+      for (size_t v = 0; v < loop_size.size(); ++v) sizes[v] = std::min(sizes[v], loop_size[v]);
       sizing.face_size = param::face_size_from_vertices(mesh, sizes);
-      sizing.report = {{"mode", curve_size.empty() ? "thin-parts" : "thin-parts+feature-loops"},
+      sizing.report = {{"mode", loop_size.empty() ? "thin-parts" : "thin-parts+feature-loops"},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
                        {"thin_area_share", number(thin_area / area)}};
