@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cmath>
+#include <cstdint>
 #include <array>
 #include <limits>
 #include <map>
@@ -417,7 +418,6 @@ struct PinnedLayout::Impl {
   struct Face {
     std::vector<int> ys;                             // reduced variables of the face
     Eigen::Matrix<double, 4, Eigen::Dynamic> M;      // edge-vector coordinates = M·y[ys]
-    std::vector<int> offsets;                        // ys² positions in H's value array
   };
   LayoutDomain domain;
   Reduction red;                  // internal variables
@@ -440,8 +440,17 @@ struct PinnedLayout::Impl {
   std::vector<int> dir_axis;
   double dir_weight = 0;
   std::vector<double> face_value;
-  std::vector<Eigen::VectorXd> face_g;
-  std::vector<Eigen::MatrixXd> face_h;
+  // Per-face gradients and Hessians in the reduced variables, one flat array each: face f's
+  // gradient at g_base[f] (k entries), its Hessian at h_base[f] (k×k, column-major).
+  std::vector<double> face_g, face_h;
+  std::vector<size_t> g_base, h_base;
+  // The assembly as a gather: H's value e sums face_h[h_source[h_start[e] ..]] and free variable
+  // i's gradient face_g[g_source[g_start[i] ..]], both in face order, the order in which a
+  // scatter over the faces adds them (the same sums to the bit), so that entries and variables
+  // can be summed in parallel. h_row/h_col: the entry's row and column.
+  std::vector<size_t> h_start, g_start;
+  std::vector<std::uint32_t> h_source, g_source;
+  std::vector<int> h_row, h_col;
 
   int n() const { return red.n_free(); }
 
@@ -458,6 +467,21 @@ struct PinnedLayout::Impl {
     }
 #endif
     for (int f = 0; f < nf; ++f) work(f);
+  }
+
+  // work(i) for i in [0, n), in parallel chunks above kPinParallelMinFaces items.
+  template <class F>
+  void for_range(int n, F&& work) {
+#ifdef QUADIFY_WITH_TBB
+    if (n >= kPinParallelMinFaces) {
+      tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096),
+                        [&](const tbb::blocked_range<int>& r) {
+                          for (int i = r.begin(); i < r.end(); ++i) work(i);
+                        });
+      return;
+    }
+#endif
+    for (int i = 0; i < n; ++i) work(i);
   }
 
   Eigen::Matrix2d edge_matrix(const Eigen::VectorXd& xx, int f) const {
@@ -477,8 +501,8 @@ struct PinnedLayout::Impl {
     const int nf = domain.n_faces();
     face_value.resize(nf);
     if (derivatives) {
-      face_g.resize(nf);
-      face_h.resize(nf);
+      face_g.resize(g_base[nf]);  // no-ops after the first evaluation
+      face_h.resize(h_base[nf]);
     }
     for_faces([&](int f) {
       const Eigen::Matrix2d J = edge_matrix(xx, f) * domain.rest_inverse[f];
@@ -507,12 +531,12 @@ struct PinnedLayout::Impl {
       // M'·g4 and M'·h4·M column by column: no temporaries, no GEMM set-up for a k×k result.
       const Face& el = faces[f];
       const Eigen::Index k = el.M.cols();
-      face_g[f].resize(k);  // no-ops after the first evaluation
-      face_h[f].resize(k, k);
+      double* fg = face_g.data() + g_base[f];
+      double* fh = face_h.data() + h_base[f];
       for (Eigen::Index i = 0; i < k; ++i) {
         const Eigen::Vector4d hm = h4 * el.M.col(i);
-        face_g[f][i] = el.M.col(i).dot(g4);
-        for (Eigen::Index j = 0; j <= i; ++j) face_h[f](j, i) = face_h[f](i, j) = el.M.col(j).dot(hm);
+        fg[i] = el.M.col(i).dot(g4);
+        for (Eigen::Index j = 0; j <= i; ++j) fh[j + i * k] = fh[i + j * k] = el.M.col(j).dot(hm);
       }
     });
     double energy = 0;
@@ -521,28 +545,35 @@ struct PinnedLayout::Impl {
       energy += face_value[f];
     }
     if (!derivatives) return energy;
-    g->setZero(n());
-    if (Hv) Hv->setZero(n());
+    g->resize(n());
     double* vals = H.valuePtr();
-    std::fill(vals, vals + H.nonZeros(), 0.0);
-    for (int f = 0; f < nf; ++f) {
-      const Face& el = faces[f];
-      const size_t k = el.ys.size();
-      for (size_t i = 0; i < k; ++i)
-        if (state[el.ys[i]] == 0) (*g)[el.ys[i]] += face_g[f][i];
-      for (size_t j = 0; j < k; ++j) {
-        const bool free_j = state[el.ys[j]] == 0;
-        for (size_t i = 0; i < k; ++i) {
-          if (state[el.ys[i]] != 0) continue;
-          if (free_j)
-            vals[el.offsets[j * k + i]] += face_h[f](i, j);
-          else if (Hv)
-            (*Hv)[el.ys[i]] += face_h[f](i, j) * (*v)[el.ys[j]];
+    for_range(n(), [&](int i) {
+      double sum = 0;
+      if (state[i] == 0)
+        for (size_t s = g_start[i]; s < g_start[i + 1]; ++s) sum += face_g[g_source[s]];
+      (*g)[i] = sum;
+    });
+    for_range(static_cast<int>(H.nonZeros()), [&](int e) {
+      double sum = 0;
+      if (state[h_row[e]] == 0 && state[h_col[e]] == 0)
+        for (size_t s = h_start[e]; s < h_start[e + 1]; ++s) sum += face_h[h_source[s]];
+      else if (h_row[e] == h_col[e])
+        sum = 1;
+      vals[e] = sum;
+    });
+    if (Hv) {  // the free rows' response to the non-free columns' displacement v
+      Hv->setZero(n());
+      for (int f = 0; f < nf; ++f) {
+        const Face& el = faces[f];
+        const size_t k = el.ys.size();
+        const double* fh = face_h.data() + h_base[f];
+        for (size_t j = 0; j < k; ++j) {
+          if (state[el.ys[j]] == 0) continue;
+          for (size_t i = 0; i < k; ++i)
+            if (state[el.ys[i]] == 0) (*Hv)[el.ys[i]] += fh[i + j * k] * (*v)[el.ys[j]];
         }
       }
     }
-    for (int i = 0; i < n(); ++i)
-      if (state[i] != 0) vals[diag_offset[i]] = 1;
     return energy;
   }
 
@@ -572,15 +603,26 @@ struct PinnedLayout::Impl {
     mean_diag = n_free_rows > 0 ? mean_diag / n_free_rows : 1;
     if (!(mean_diag > 0)) mean_diag = 1;
     double shift = kPinRegularization * mean_diag;
-    for (int attempt = 0; attempt < 6; ++attempt, shift *= 100) {
-      Eigen::SparseMatrix<double> A = H;
+    // The shift goes onto H's free diagonal in place (no copy of H per solve) and the saved
+    // values are put back after.
+    std::vector<double> diagonal;
+    diagonal.reserve(static_cast<size_t>(n_free_rows));
+    for (int i = 0; i < n(); ++i)
+      if (state[i] == 0) diagonal.push_back(H.valuePtr()[diag_offset[i]]);
+    auto set_diagonal = [&](double add) {
+      size_t d = 0;
       for (int i = 0; i < n(); ++i)
-        if (state[i] == 0) A.valuePtr()[diag_offset[i]] += shift;
-      if (!solver.factorize(A).is_ok()) continue;
+        if (state[i] == 0) H.valuePtr()[diag_offset[i]] = diagonal[d++] + add;
+    };
+    bool solved = false;
+    for (int attempt = 0; attempt < 6 && !solved; ++attempt, shift *= 100) {
+      set_diagonal(shift);
+      if (!solver.factorize(H).is_ok()) continue;
       *out = solver.solve(rhs);
-      if (out->allFinite()) return true;
+      solved = out->allFinite();
     }
-    return false;
+    set_diagonal(0);
+    return solved;
   }
   bool solve(const Eigen::VectorXd& rhs, Eigen::VectorXd* dy) {
     Eigen::MatrixXd out;
@@ -833,12 +875,58 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   };
   m.diag_offset.resize(m.n());
   for (int i = 0; i < m.n(); ++i) m.diag_offset[i] = locate(i, i);
-  for (Impl::Face& el : m.faces) {
-    const size_t k = el.ys.size();
-    el.offsets.resize(k * k);
-    for (size_t j = 0; j < k; ++j)
-      for (size_t i = 0; i < k; ++i) el.offsets[j * k + i] = locate(el.ys[i], el.ys[j]);
+  // The flat per-face arrays and the gather lists (see Impl::h_source), in the scatter's order:
+  // faces ascending, then column j, then row i.
+  const int nfaces = static_cast<int>(m.faces.size());
+  m.g_base.assign(nfaces + 1, 0);
+  m.h_base.assign(nfaces + 1, 0);
+  for (int f = 0; f < nfaces; ++f) {
+    const size_t k = m.faces[f].ys.size();
+    m.g_base[f + 1] = m.g_base[f] + k;
+    m.h_base[f + 1] = m.h_base[f] + k * k;
   }
+  if (m.h_base[nfaces] > std::numeric_limits<std::uint32_t>::max())
+    return core::Status::numerical_failure("PinnedLayout: too many Hessian entries per face");
+  const size_t nnz = static_cast<size_t>(m.H.nonZeros());
+  std::vector<int> entry_of(m.h_base[nfaces]);
+  m.h_start.assign(nnz + 1, 0);
+  m.g_start.assign(static_cast<size_t>(m.n()) + 1, 0);
+  for (int f = 0; f < nfaces; ++f) {
+    const std::vector<int>& ys = m.faces[f].ys;
+    const size_t k = ys.size();
+    for (size_t j = 0; j < k; ++j)
+      for (size_t i = 0; i < k; ++i) {
+        const int e = locate(ys[i], ys[j]);
+        entry_of[m.h_base[f] + i + j * k] = e;
+        ++m.h_start[e + 1];
+      }
+    for (size_t i = 0; i < k; ++i) ++m.g_start[ys[i] + 1];
+  }
+  for (size_t e = 0; e < nnz; ++e) m.h_start[e + 1] += m.h_start[e];
+  for (int i = 0; i < m.n(); ++i) m.g_start[i + 1] += m.g_start[i];
+  m.h_source.resize(m.h_base[nfaces]);
+  m.g_source.resize(m.g_base[nfaces]);
+  {
+    std::vector<size_t> h_fill(m.h_start.begin(), m.h_start.end() - 1);
+    std::vector<size_t> g_fill(m.g_start.begin(), m.g_start.end() - 1);
+    for (int f = 0; f < nfaces; ++f) {
+      const std::vector<int>& ys = m.faces[f].ys;
+      const size_t k = ys.size();
+      for (size_t j = 0; j < k; ++j)
+        for (size_t i = 0; i < k; ++i) {
+          const size_t local = m.h_base[f] + i + j * k;
+          m.h_source[h_fill[entry_of[local]]++] = static_cast<std::uint32_t>(local);
+        }
+      for (size_t i = 0; i < k; ++i) m.g_source[g_fill[ys[i]]++] = static_cast<std::uint32_t>(m.g_base[f] + i);
+    }
+  }
+  m.h_row.resize(nnz);
+  m.h_col.resize(nnz);
+  for (int c = 0; c < m.n(); ++c)
+    for (int e = m.H.outerIndexPtr()[c]; e < m.H.outerIndexPtr()[c + 1]; ++e) {
+      m.h_row[e] = m.H.innerIndexPtr()[e];
+      m.h_col[e] = c;
+    }
   if (m.n() > 0) {
     std::fill(m.H.valuePtr(), m.H.valuePtr() + m.H.nonZeros(), 0.0);
     for (int i = 0; i < m.n(); ++i) m.H.valuePtr()[m.diag_offset[i]] = 1;
