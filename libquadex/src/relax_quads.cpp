@@ -45,6 +45,13 @@ constexpr double kSnapCovered = 0.02;
 // raised the Hausdorff distance 0.0065 -> 0.0090; teapot lost 2% of its feature capture when
 // none could).
 constexpr double kSnapDistanceShare = 0.75;
+// Tentative snaps (see RelaxOptions::tentative_snaps): those whose feature point has a surface
+// sample within the snap's reach at least this share of the largest distance after the repair,
+// the farthest first, at most kTentativeMax of them.
+constexpr double kTentativeShare = 0.75;
+constexpr size_t kTentativeMax = 4;
+// This many of the chosen snaps (the farthest first) are tried alone before all of them together.
+constexpr size_t kTentativeSingles = 2;
 // Fraction of the way to the neighbour centroid tried after the full step is refused.
 constexpr double kHalfStep = 0.5;
 // Fractions of the way to the centroid of a bad quad the vertex belongs to, tried next.
@@ -406,7 +413,10 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // mean quad edge, no quad edge around v passes by p already, every quad around v keeps its
   // quality or stays at least snap_min_quality, and its quads get no farther from the surface
   // (see RelaxOptions::snap_reach); true if it moved.
-  auto snap_onto_feature = [&](int v) {
+  // With check_quality false the quads' quality is not asked (a tentative snap, see below);
+  // *refused_for_quality (if given) tells whether only the quality refused it.
+  auto snap_onto_feature = [&](int v, bool check_quality = true, bool* refused_for_quality = nullptr) {
+    if (refused_for_quality) *refused_for_quality = false;
     const Eigen::Vector3d old = q.V.row(v).transpose();
     const double h = mean_edge(v);
     const Point cp = snap_tree->closest_point(Point(old.x(), old.y(), old.z()));
@@ -429,11 +439,13 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       distance_before = std::max(distance_before, quad_distance(f));
     }
     q.V.row(v) = p.transpose();
-    bool keep = true;
-    for (size_t i = 0; i < before.size() && keep; ++i)
-      keep = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
-    for (size_t i = 0; i < before.size() && keep; ++i)
-      keep = quad_distance(vertex_quads[v][i]) <= std::max(distance_before, snap_distance_allowed);
+    bool quality_kept = true, distance_kept = true;
+    for (size_t i = 0; i < before.size() && quality_kept && check_quality; ++i)
+      quality_kept = quad_quality(vertex_quads[v][i]) >= std::min(before[i], options.snap_min_quality);
+    for (size_t i = 0; i < before.size() && distance_kept; ++i)
+      distance_kept = quad_distance(vertex_quads[v][i]) <= std::max(distance_before, snap_distance_allowed);
+    if (refused_for_quality) *refused_for_quality = !quality_kept && distance_kept;
+    const bool keep = quality_kept && distance_kept;
     if (!keep) q.V.row(v) = old.transpose();
     return keep;
   };
@@ -641,86 +653,111 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   for (int f = 0; f < nf; ++f)
     if (q.degree(f) != 4)
       for (int k = 0; k < q.degree(f); ++k) touches_polygon[q.vertex(f, k)] = 1;
-  if (snap_tree && options.snap_reach > 0) {
+  // Snaps refused only for the quality of the quads around them: the vertex, its feature point,
+  // its mean quad edge.
+  std::vector<int> tentative;
+  std::vector<Eigen::Vector3d> tentative_point;
+  std::vector<double> tentative_edge;
+  const bool snapping = snap_tree && options.snap_reach > 0;
+  if (snapping) {
     for (int f = 0; f < nf; ++f)
       if (q.degree(f) == 4) snap_distance_allowed = std::max(snap_distance_allowed, quad_distance(f));
     snap_distance_allowed *= kSnapDistanceShare;
+  }
+  // The snapping pass, in vertex order; the vertices in `force` snap without the quality check
+  // (see the tentative snaps below). Collects the snaps refused only for quality.
+  auto snap_pass = [&](const std::vector<int>& force) {
     for (int v = 0; v < nv; ++v) {
       if (fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v]) continue;
-      if (snap_onto_feature(v)) {
+      const bool forced = std::find(force.begin(), force.end(), v) != force.end();
+      bool refused_for_quality = false;
+      if (snap_onto_feature(v, !forced, &refused_for_quality)) {
         on_feature[v] = 1;
         ++res.stats.n_snapped;
+        if (forced) ++res.stats.n_tentative_snaps;
+      } else if (refused_for_quality && options.tentative_snaps && force.empty()) {
+        tentative.push_back(v);
+        const Point cp = snap_tree->closest_point(Point(q.V(v, 0), q.V(v, 1), q.V(v, 2)));
+        tentative_point.emplace_back(cp.x(), cp.y(), cp.z());
+        tentative_edge.push_back(mean_edge(v));
       }
     }
-  }
-  std::vector<char> frozen(nv);
-  for (int v = 0; v < nv; ++v) frozen[v] = fixed[v] || on_feature[v];
-  // Jumps first: where they repair a quad, its neighbours need not slide (which, around a thin
-  // tip, pulls the quads off it); the steps then repair what the jumps could not.
-  res.stats.n_jumps = jump_rounds(frozen, options.min_scaled_jacobian);
-  res.stats.n_moves = relax_rounds(frozen, options.min_scaled_jacobian);
-  res.stats.n_jumps += jump_rounds(frozen, options.min_scaled_jacobian);
-  // Last resort for quads still flipped: their vertices on features and boundaries may leave
-  // them (a flipped or flat quad is worse than a crease or boundary missed by a fraction of a
-  // quad: e.g. a boundary corner placed where the boundary runs straight).
-  if (options.release_features_for_flips && count_bad(kFlipped) > 0) {
-    std::vector<char> released(nv, 0);
-    for (int f = 0; f < nf; ++f)
-      if (q.degree(f) == 4 && quad_quality(f) < kFlipped)
-        for (int k = 0; k < 4; ++k) {
-          const int v = q.vertex(f, k);
-          if ((on_feature[v] || fixed[v]) && !non_manifold[v] && !vertex_quads[v].empty()) released[v] = 1;
-        }
-    const Eigen::MatrixX3d v_before = q.V;
-    for (int v = 0; v < nv; ++v)
-      if (released[v]) frozen[v] = 0;
-    res.stats.n_moves += relax_rounds(frozen, kFlipped);
-    res.stats.n_jumps += jump_rounds(frozen, kFlipped);
-    for (int v = 0; v < nv; ++v)
-      if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
-  }
-  // Quads still flipped sit in a fold that no move of one vertex at a time opens at the
-  // threshold (octopus at 5,000 quads: a tentacle tip curling up, thinner than a quad, where the
-  // worst quad around each vertex of the fold would get worse first); slivers (below kSliver)
-  // are the same kind of knot, one step short of a fold. Around them (kUnfoldRings rings of
-  // vertices; the rest stays), the vertices go back to their extracted positions and the jumps
-  // and steps run again with raised thresholds, which move the knot's neighbours too; kept when
-  // fewer quads are below the target after and no more are flipped. (Raising the threshold
-  // everywhere also unfolds it, but pulls quads off every thin tip.) `target`: kFlipped for the
-  // folds, first, with the vertices the last resort released; then kSliver for the slivers,
-  // with every vertex on a feature or boundary where it is (a crease keeps its quad edges).
-  auto unfold = [&](const std::vector<char>& frozen_mask, double target) {
-    for (const double threshold : kUnfoldThresholds) {
-      const int flipped = count_bad(kFlipped);
-      const int below = count_bad(target);
-      if (below == 0) break;
-      std::vector<char> near(nv, 0);
+  };
+  const core::PolyMesh start_quads = q;
+  const std::vector<char> start_on_feature = on_feature;
+  const RelaxStats start_stats = res.stats;
+  if (snapping) snap_pass({});
+  // The repair after snapping (jumps, steps, the last resort, unfolding, fitting); run once, or
+  // twice with the tentative snaps (see below).
+  auto repair_after_snapping = [&]() {
+    std::vector<char> frozen(nv);
+    for (int v = 0; v < nv; ++v) frozen[v] = fixed[v] || on_feature[v];
+    // Jumps first: where they repair a quad, its neighbours need not slide (which, around a thin
+    // tip, pulls the quads off it); the steps then repair what the jumps could not.
+    res.stats.n_jumps = jump_rounds(frozen, options.min_scaled_jacobian);
+    res.stats.n_moves = relax_rounds(frozen, options.min_scaled_jacobian);
+    res.stats.n_jumps += jump_rounds(frozen, options.min_scaled_jacobian);
+    // Last resort for quads still flipped: their vertices on features and boundaries may leave
+    // them (a flipped or flat quad is worse than a crease or boundary missed by a fraction of a
+    // quad: e.g. a boundary corner placed where the boundary runs straight).
+    if (options.release_features_for_flips && count_bad(kFlipped) > 0) {
+      std::vector<char> released(nv, 0);
       for (int f = 0; f < nf; ++f)
-        if (q.degree(f) == 4 && quad_quality(f) < target)
-          for (int k = 0; k < 4; ++k) near[q.vertex(f, k)] = 1;
-      for (int ring = 0; ring < kUnfoldRings; ++ring) {
-        const std::vector<char> inner = near;
-        for (int v = 0; v < nv; ++v)
-          if (inner[v])
-            for (const int w : neighbours[v]) near[w] = 1;
-      }
-      std::vector<char> local_frozen(nv);
-      for (int v = 0; v < nv; ++v) local_frozen[v] = frozen_mask[v] || !near[v];
-      const Eigen::MatrixX3d saved = q.V;
+        if (q.degree(f) == 4 && quad_quality(f) < kFlipped)
+          for (int k = 0; k < 4; ++k) {
+            const int v = q.vertex(f, k);
+            if ((on_feature[v] || fixed[v]) && !non_manifold[v] && !vertex_quads[v].empty()) released[v] = 1;
+          }
+      const Eigen::MatrixX3d v_before = q.V;
       for (int v = 0; v < nv; ++v)
-        if (!local_frozen[v]) q.V.row(v) = quads.V.row(v);  // from the extracted positions
-      int jumps = jump_rounds(local_frozen, threshold);
-      const int moves = relax_rounds(local_frozen, threshold);
-      jumps += jump_rounds(local_frozen, threshold);
-      const int below_after = count_bad(target);
-      if (count_bad(kFlipped) <= flipped && below_after < below) {
-        res.stats.n_jumps += jumps;
-        res.stats.n_moves += moves;
-        res.stats.n_unfolded += below - below_after;
-      } else {
-        q.V = saved;
-      }
+        if (released[v]) frozen[v] = 0;
+      res.stats.n_moves += relax_rounds(frozen, kFlipped);
+      res.stats.n_jumps += jump_rounds(frozen, kFlipped);
+      for (int v = 0; v < nv; ++v)
+        if (released[v] && q.V.row(v) != v_before.row(v)) ++res.stats.n_feature_vertices_moved;
     }
+    // Quads still flipped sit in a fold that no move of one vertex at a time opens at the
+    // threshold (octopus at 5,000 quads: a tentacle tip curling up, thinner than a quad, where the
+    // worst quad around each vertex of the fold would get worse first); slivers (below kSliver)
+    // are the same kind of knot, one step short of a fold. Around them (kUnfoldRings rings of
+    // vertices; the rest stays), the vertices go back to their extracted positions and the jumps
+    // and steps run again with raised thresholds, which move the knot's neighbours too; kept when
+    // fewer quads are below the target after and no more are flipped. (Raising the threshold
+    // everywhere also unfolds it, but pulls quads off every thin tip.) `target`: kFlipped for the
+    // folds, first, with the vertices the last resort released; then kSliver for the slivers,
+    // with every vertex on a feature or boundary where it is (a crease keeps its quad edges).
+    auto unfold = [&](const std::vector<char>& frozen_mask, double target) {
+      for (const double threshold : kUnfoldThresholds) {
+        const int flipped = count_bad(kFlipped);
+        const int below = count_bad(target);
+        if (below == 0) break;
+        std::vector<char> near(nv, 0);
+        for (int f = 0; f < nf; ++f)
+          if (q.degree(f) == 4 && quad_quality(f) < target)
+            for (int k = 0; k < 4; ++k) near[q.vertex(f, k)] = 1;
+        for (int ring = 0; ring < kUnfoldRings; ++ring) {
+          const std::vector<char> inner = near;
+          for (int v = 0; v < nv; ++v)
+            if (inner[v])
+              for (const int w : neighbours[v]) near[w] = 1;
+        }
+        std::vector<char> local_frozen(nv);
+        for (int v = 0; v < nv; ++v) local_frozen[v] = frozen_mask[v] || !near[v];
+        const Eigen::MatrixX3d saved = q.V;
+        for (int v = 0; v < nv; ++v)
+          if (!local_frozen[v]) q.V.row(v) = quads.V.row(v);  // from the extracted positions
+        int jumps = jump_rounds(local_frozen, threshold);
+        const int moves = relax_rounds(local_frozen, threshold);
+        jumps += jump_rounds(local_frozen, threshold);
+        const int below_after = count_bad(target);
+        if (count_bad(kFlipped) <= flipped && below_after < below) {
+          res.stats.n_jumps += jumps;
+          res.stats.n_moves += moves;
+          res.stats.n_unfolded += below - below_after;
+        } else {
+          q.V = saved;
+        }
+      }
   };
   unfold(frozen, kFlipped);
   std::vector<char> strict_frozen(nv);
@@ -737,6 +774,88 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     std::vector<char> moved(nv, 0);
     for (int v = 0; v < nv; ++v) moved[v] = q.V.row(v) != v_before.row(v);
     if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(&moved);
+  }
+  };
+  // Tentative snaps: a snap refused because a quad around the vertex would fold or flatten is
+  // often one that the repair then makes good (the neighbours move; fandisk at 5,000 quads: a
+  // crease corner cut off by 0.0031 of the diagonal, the largest distance of the mesh, is met).
+  // The repair runs first without them, then again from the same start with all of them; the
+  // second result is kept if it has no more flipped quads and no more quads below
+  // min_scaled_jacobian, a worst quad no worse (or at least snap_min_quality), and a smaller
+  // largest two-sided distance to the surface samples.
+  if (tentative.empty()) {
+    repair_after_snapping();
+  } else {
+    auto worst_quality = [&]() {
+      double w = std::numeric_limits<double>::infinity();
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4) w = std::min(w, quad_quality(f));
+      return w;
+    };
+    auto largest_two_sided = [&]() {
+      std::vector<int> owner(ns, -1);
+      std::vector<double> dist(ns, 0);
+      double d = 0;
+      if (assign_owners(&owner, &dist))
+        for (int s = 0; s < ns; ++s) d = std::max(d, dist[s]);
+      for (int f = 0; f < nf; ++f)
+        if (q.degree(f) == 4) d = std::max(d, quad_distance(f));
+      return d;
+    };
+    repair_after_snapping();
+    const core::PolyMesh plain_quads = q;
+    const std::vector<char> plain_on_feature = on_feature;
+    const RelaxStats plain_stats = res.stats;
+    const int plain_flipped = count_bad(kFlipped);
+    const int plain_bad = count_bad(options.min_scaled_jacobian);
+    const double plain_worst = worst_quality();
+    const double plain_distance = largest_two_sided();
+    // Only the snaps where the repaired quads leave the surface farthest: a sample within the
+    // snap's reach of its feature point at least kTentativeShare of the largest distance.
+    std::vector<std::pair<double, int>> chosen;  // (local distance, vertex)
+    {
+      std::vector<int> owner(ns, -1);
+      std::vector<double> dist(ns, 0);
+      if (assign_owners(&owner, &dist))
+        for (size_t i = 0; i < tentative.size(); ++i) {
+          double local = 0;
+          for (int smp : samples_near(tentative_point[i], options.snap_reach * tentative_edge[i]))
+            local = std::max(local, dist[smp]);
+          if (local >= kTentativeShare * plain_distance) chosen.emplace_back(local, tentative[i]);
+        }
+    }
+    std::sort(chosen.begin(), chosen.end(), [](const auto& a, const auto& b) {
+      return a.first != b.first ? a.first > b.first : a.second < b.second;
+    });
+    if (chosen.size() > kTentativeMax) chosen.resize(kTentativeMax);
+    // Trials: each of the first kTentativeSingles chosen snaps alone (the farthest first), then
+    // all chosen together; the first one kept ends them.
+    std::vector<std::vector<int>> trials;
+    for (size_t i = 0; i < std::min(chosen.size(), kTentativeSingles); ++i)
+      trials.push_back({chosen[i].second});
+    if (chosen.size() > 1) {
+      trials.emplace_back();
+      for (const auto& [local, v] : chosen) trials.back().push_back(v);
+    }
+    int snapped = 0;
+    bool better = false;
+    for (size_t t = 0; t < trials.size() && !better; ++t) {
+      q = start_quads;
+      on_feature = start_on_feature;
+      res.stats = start_stats;
+      snap_pass(trials[t]);
+      snapped = res.stats.n_tentative_snaps;
+      repair_after_snapping();
+      better = snapped > 0 && count_bad(kFlipped) <= plain_flipped &&
+               count_bad(options.min_scaled_jacobian) <= plain_bad &&
+               worst_quality() >= std::min(plain_worst, options.snap_min_quality) &&
+               largest_two_sided() < plain_distance;
+    }
+    if (!better) {
+      q = plain_quads;
+      on_feature = plain_on_feature;
+      res.stats = plain_stats;
+    }
   }
   res.stats.n_bad_after = count_bad(options.min_scaled_jacobian);
   res.stats.n_flipped_after = count_bad(kFlipped);

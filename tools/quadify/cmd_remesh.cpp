@@ -600,6 +600,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"feature_vertices_moved", relax_stats.n_feature_vertices_moved},
                        {"unfolded", relax_stats.n_unfolded},
                        {"snapped", relax_stats.n_snapped},
+                       {"tentative_snaps", relax_stats.n_tentative_snaps},
                        {"fitted", relax_stats.n_fitted},
                        {"fit_distance_before", relax_stats.fit_distance_before},
                        {"fit_distance_after", relax_stats.fit_distance_after},
