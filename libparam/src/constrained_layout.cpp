@@ -454,27 +454,12 @@ struct PinnedLayout::Impl {
 
   int n() const { return red.n_free(); }
 
+  // work(i) for i in [0, n), in parallel chunks of `grain` from kPinParallelMinFaces items on.
   template <class F>
-  void for_faces(F&& work) {
-    const int nf = domain.n_faces();
-#ifdef QUADIFY_WITH_TBB
-    if (nf >= kPinParallelMinFaces) {
-      tbb::parallel_for(tbb::blocked_range<int>(0, nf, 256),
-                        [&](const tbb::blocked_range<int>& r) {
-                          for (int f = r.begin(); f < r.end(); ++f) work(f);
-                        });
-      return;
-    }
-#endif
-    for (int f = 0; f < nf; ++f) work(f);
-  }
-
-  // work(i) for i in [0, n), in parallel chunks above kPinParallelMinFaces items.
-  template <class F>
-  void for_range(int n, F&& work) {
+  void for_range(int n, int grain, F&& work) {
 #ifdef QUADIFY_WITH_TBB
     if (n >= kPinParallelMinFaces) {
-      tbb::parallel_for(tbb::blocked_range<int>(0, n, 4096),
+      tbb::parallel_for(tbb::blocked_range<int>(0, n, grain),
                         [&](const tbb::blocked_range<int>& r) {
                           for (int i = r.begin(); i < r.end(); ++i) work(i);
                         });
@@ -482,6 +467,10 @@ struct PinnedLayout::Impl {
     }
 #endif
     for (int i = 0; i < n; ++i) work(i);
+  }
+  template <class F>
+  void for_faces(F&& work) {
+    for_range(domain.n_faces(), 256, work);
   }
 
   Eigen::Matrix2d edge_matrix(const Eigen::VectorXd& xx, int f) const {
@@ -547,13 +536,13 @@ struct PinnedLayout::Impl {
     if (!derivatives) return energy;
     g->resize(n());
     double* vals = H.valuePtr();
-    for_range(n(), [&](int i) {
+    for_range(n(), 4096, [&](int i) {
       double sum = 0;
       if (state[i] == 0)
         for (size_t s = g_start[i]; s < g_start[i + 1]; ++s) sum += face_g[g_source[s]];
       (*g)[i] = sum;
     });
-    for_range(static_cast<int>(H.nonZeros()), [&](int e) {
+    for_range(static_cast<int>(H.nonZeros()), 4096, [&](int e) {
       double sum = 0;
       if (state[h_row[e]] == 0 && state[h_col[e]] == 0)
         for (size_t s = h_start[e]; s < h_start[e + 1]; ++s) sum += face_h[h_source[s]];
