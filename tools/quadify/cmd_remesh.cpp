@@ -32,6 +32,7 @@ struct RemeshArgs {
   bool measure = true;
   bool relax = true;
   bool feature_snap = true;
+  bool tentative_snaps = true;
   bool fit = true;
   bool thin_parts = true;  // retry a dead end with thin-part sizing (param::thin_part_vertex_size)
   bool feature_sizing = true;  // smaller quads around short closed feature curves (param::feature_loop_vertex_size)
@@ -565,6 +566,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     quadex::RelaxOptions relax_options;
     relax_options.feature_edges = param_options.feature_edges;
     if (!args.feature_snap) relax_options.snap_reach = 0;
+    relax_options.tentative_snaps = args.tentative_snaps;
     if (!args.fit) relax_options.fit_fraction = 0;
     quadex::RelaxResult relaxed = quadex::relax_bad_quads(extracted.quads, mesh, relax_options);
     progress.end();
@@ -744,6 +746,11 @@ CommandRunner register_remesh(CLI::App& app) {
   app.add_flag("!--no-feature-snap", args->feature_snap,
                "Do not move quad vertices onto a nearby feature curve that their quads cut off (by "
                "default, part of the relaxation; see relax.snapped in the report)");
+  app.add_flag("!--no-tentative-snaps", args->tentative_snaps,
+               "Do not retry the snaps refused because a quad around the vertex would fold, where the "
+               "quads are farthest from the input (by default the relaxation is run again with the "
+               "farthest two alone, then up to four together, and kept when it is closer to the input "
+               "without worse quads; see relax.tentative_snaps in the report)");
   app.add_flag("!--no-fit", args->fit,
                "Do not move quad vertices where the quads are farthest from the input (by default, part "
                "of the relaxation: a vertex whose quads deviate by more than 0.8 of the largest "
