@@ -864,7 +864,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   };
   m.diag_offset.resize(m.n());
   for (int i = 0; i < m.n(); ++i) m.diag_offset[i] = locate(i, i);
-  // The flat per-face arrays and the gather lists (see Impl::h_source), in the scatter's order:
+  // The flat per-face arrays and the gather lists (see Impl::h_source), in a scatter's order:
   // faces ascending, then column j, then row i.
   const int nfaces = static_cast<int>(m.faces.size());
   m.g_base.assign(nfaces + 1, 0);
@@ -875,7 +875,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
     m.h_base[f + 1] = m.h_base[f] + k * k;
   }
   if (m.h_base[nfaces] > std::numeric_limits<std::uint32_t>::max())
-    return core::Status::numerical_failure("PinnedLayout: too many Hessian entries per face");
+    return core::Status::numerical_failure("PinnedLayout: more per-face Hessian entries than 32-bit indices hold");
   const size_t nnz = static_cast<size_t>(m.H.nonZeros());
   std::vector<int> entry_of(m.h_base[nfaces]);
   m.h_start.assign(nnz + 1, 0);

@@ -758,31 +758,32 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
           q.V = saved;
         }
       }
-  };
-  unfold(frozen, kFlipped);
-  std::vector<char> strict_frozen(nv);
-  for (int v = 0; v < nv; ++v) strict_frozen[v] = fixed[v] || on_feature[v];
-  unfold(strict_frozen, kSliver);
-  // The fitting measures the quads as they will be split, and may change which split is closer.
-  if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(nullptr);
-  if (options.fit_fraction > 0 && options.fit_rounds > 0) {
-    std::vector<char> fit_frozen(nv, 0);
-    for (int v = 0; v < nv; ++v)
-      fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v];
-    const Eigen::MatrixX3d v_before = q.V;
-    fit_to_surface(fit_frozen);
-    std::vector<char> moved(nv, 0);
-    for (int v = 0; v < nv; ++v) moved[v] = q.V.row(v) != v_before.row(v);
-    if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(&moved);
-  }
+    };
+    unfold(frozen, kFlipped);
+    std::vector<char> strict_frozen(nv);
+    for (int v = 0; v < nv; ++v) strict_frozen[v] = fixed[v] || on_feature[v];
+    unfold(strict_frozen, kSliver);
+    // The fitting measures the quads as they will be split, and may change which split is closer.
+    if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(nullptr);
+    if (options.fit_fraction > 0 && options.fit_rounds > 0) {
+      std::vector<char> fit_frozen(nv, 0);
+      for (int v = 0; v < nv; ++v)
+        fit_frozen[v] = fixed[v] || on_feature[v] || non_manifold[v] || touches_polygon[v];
+      const Eigen::MatrixX3d v_before = q.V;
+      fit_to_surface(fit_frozen);
+      std::vector<char> moved(nv, 0);
+      for (int v = 0; v < nv; ++v) moved[v] = q.V.row(v) != v_before.row(v);
+      if (options.choose_diagonals) res.stats.n_diagonals_turned += choose_diagonals(&moved);
+    }
   };
   // Tentative snaps: a snap refused because a quad around the vertex would fold or flatten is
   // often one that the repair then makes good (the neighbours move; fandisk at 5,000 quads: a
   // crease corner cut off by 0.0031 of the diagonal, the largest distance of the mesh, is met).
-  // The repair runs first without them, then again from the same start with all of them; the
-  // second result is kept if it has no more flipped quads and no more quads below
-  // min_scaled_jacobian, a worst quad no worse (or at least snap_min_quality), and a smaller
-  // largest two-sided distance to the surface samples.
+  // The repair runs first without them; then, for the refused snaps where the repaired quads are
+  // farthest from the surface, the snapping pass and the repair run again from the same start
+  // with them forced (trials below); a trial is kept if it has no more flipped quads and no more
+  // quads below min_scaled_jacobian, a worst quad no worse (or at least snap_min_quality), and a
+  // smaller largest two-sided distance to the surface samples.
   if (tentative.empty()) {
     repair_after_snapping();
   } else {
@@ -792,7 +793,9 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         if (q.degree(f) == 4) w = std::min(w, quad_quality(f));
       return w;
     };
-    auto largest_two_sided = [&]() {
+    // The largest two-sided distance between the quads and the surface samples; *sample_dist
+    // (if given) gets each sample's distance to its closest face.
+    auto largest_two_sided = [&](std::vector<double>* sample_dist = nullptr) {
       std::vector<int> owner(ns, -1);
       std::vector<double> dist(ns, 0);
       double d = 0;
@@ -800,6 +803,7 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
         for (int s = 0; s < ns; ++s) d = std::max(d, dist[s]);
       for (int f = 0; f < nf; ++f)
         if (q.degree(f) == 4) d = std::max(d, quad_distance(f));
+      if (sample_dist) *sample_dist = std::move(dist);
       return d;
     };
     repair_after_snapping();
@@ -809,20 +813,16 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
     const int plain_flipped = count_bad(kFlipped);
     const int plain_bad = count_bad(options.min_scaled_jacobian);
     const double plain_worst = worst_quality();
-    const double plain_distance = largest_two_sided();
+    std::vector<double> plain_sample_dist;
+    const double plain_distance = largest_two_sided(&plain_sample_dist);
     // Only the snaps where the repaired quads leave the surface farthest: a sample within the
     // snap's reach of its feature point at least kTentativeShare of the largest distance.
     std::vector<std::pair<double, int>> chosen;  // (local distance, vertex)
-    {
-      std::vector<int> owner(ns, -1);
-      std::vector<double> dist(ns, 0);
-      if (assign_owners(&owner, &dist))
-        for (size_t i = 0; i < tentative.size(); ++i) {
-          double local = 0;
-          for (int smp : samples_near(tentative_point[i], options.snap_reach * tentative_edge[i]))
-            local = std::max(local, dist[smp]);
-          if (local >= kTentativeShare * plain_distance) chosen.emplace_back(local, tentative[i]);
-        }
+    for (size_t i = 0; i < tentative.size(); ++i) {
+      double local = 0;
+      for (int smp : samples_near(tentative_point[i], options.snap_reach * tentative_edge[i]))
+        local = std::max(local, plain_sample_dist[smp]);
+      if (local >= kTentativeShare * plain_distance) chosen.emplace_back(local, tentative[i]);
     }
     std::sort(chosen.begin(), chosen.end(), [](const auto& a, const auto& b) {
       return a.first != b.first ? a.first > b.first : a.second < b.second;
@@ -837,16 +837,14 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
       trials.emplace_back();
       for (const auto& [local, v] : chosen) trials.back().push_back(v);
     }
-    int snapped = 0;
     bool better = false;
     for (size_t t = 0; t < trials.size() && !better; ++t) {
       q = start_quads;
       on_feature = start_on_feature;
       res.stats = start_stats;
       snap_pass(trials[t]);
-      snapped = res.stats.n_tentative_snaps;
       repair_after_snapping();
-      better = snapped > 0 && count_bad(kFlipped) <= plain_flipped &&
+      better = res.stats.n_tentative_snaps > 0 && count_bad(kFlipped) <= plain_flipped &&
                count_bad(options.min_scaled_jacobian) <= plain_bad &&
                worst_quality() >= std::min(plain_worst, options.snap_min_quality) &&
                largest_two_sided() < plain_distance;
