@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <queue>
 #include <stdexcept>
 #include <string>
@@ -110,6 +111,50 @@ void smooth(const std::vector<std::vector<int>>& nb, int passes, std::vector<T>*
   }
 }
 
+// The feature edges at each vertex (#V sorted lists of the other ends); `who` names the caller in
+// the error for a vertex out of range.
+std::vector<std::vector<int>> feature_neighbours(const core::TriMesh& mesh,
+                                                 const std::vector<std::array<int, 2>>& feature_edges,
+                                                 const char* who) {
+  const int nv = mesh.n_vertices();
+  std::vector<std::vector<int>> curve_nb(nv);
+  for (const auto& [a, b] : feature_edges) {
+    if (a < 0 || a >= nv || b < 0 || b >= nv)
+      throw std::invalid_argument(std::string(who) + ": feature edge (" + std::to_string(a) + ", " +
+                                  std::to_string(b) + ") has a vertex out of range");
+    if (a == b) continue;
+    curve_nb[a].push_back(b);
+    curve_nb[b].push_back(a);
+  }
+  for (std::vector<int>& nb : curve_nb) {
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  return curve_nb;
+}
+
+// Multi-source Dijkstra from the vertices whose size is below 1: size(v) = min over them c of
+// size(c) + per_length · d(v, c), d along mesh edges.
+void grade_from_sources(const core::TriMesh& mesh, double per_length, std::vector<double>* size) {
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  for (int v = 0; v < mesh.n_vertices(); ++v)
+    if ((*size)[v] < 1) queue.push({(*size)[v], v});
+  const std::vector<std::vector<int>> nb = core::vertex_neighbours(mesh);
+  while (!queue.empty()) {
+    const auto [s, v] = queue.top();
+    queue.pop();
+    if (s > (*size)[v]) continue;
+    for (const int w : nb[v]) {
+      const double sw = s + per_length * (mesh.V.row(w) - mesh.V.row(v)).norm();
+      if (sw < (*size)[w]) {
+        (*size)[w] = sw;
+        queue.push({sw, w});
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<double> adaptive_face_size(const core::TriMesh& mesh, const AdaptiveSizingOptions& options) {
@@ -153,6 +198,7 @@ std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge
   return size;
 }
 
+
 std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
                                               const std::vector<std::array<int, 2>>& feature_edges,
                                               double edge_length, const FeatureLoopSizingOptions& options) {
@@ -161,23 +207,9 @@ std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
     throw std::invalid_argument("feature_loop_vertex_size: edge_length, min_loop_edges and grade > 0 and "
                                 "min_ratio in (0, 1] required");
   const int nv = mesh.n_vertices();
-  std::vector<std::vector<int>> curve_nb(nv);
-  for (const auto& [a, b] : feature_edges) {
-    if (a < 0 || a >= nv || b < 0 || b >= nv)
-      throw std::invalid_argument("feature_loop_vertex_size: feature edge (" + std::to_string(a) + ", " +
-                                  std::to_string(b) + ") has a vertex out of range");
-    if (a == b) continue;
-    curve_nb[a].push_back(b);
-    curve_nb[b].push_back(a);
-  }
-  for (std::vector<int>& nb : curve_nb) {
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-  }
+  const std::vector<std::vector<int>> curve_nb = feature_neighbours(mesh, feature_edges, "feature_loop_vertex_size");
   auto point = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v); };
   // Closed loops: connected sets of curve vertices that all lie on exactly two curve edges.
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
   std::vector<double> size(nv, 1.0);
   std::vector<char> seen(nv, 0);
   for (int start = 0; start < nv; ++start) {
@@ -201,25 +233,47 @@ std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
     if (!closed || !(relative < 1)) continue;
     for (const int v : loop) {
       size[v] = std::max(options.min_ratio, relative);
-      queue.push({size[v], v});
     }
   }
-  // Multi-source Dijkstra: size(v) = min over sources c of size(c) + grade · d(v, c) / edge_length,
-  // d along mesh edges.
-  const std::vector<std::vector<int>> nb = core::vertex_neighbours(mesh);
-  const double per_length = options.grade / edge_length;
-  while (!queue.empty()) {
-    const auto [s, v] = queue.top();
-    queue.pop();
-    if (s > size[v]) continue;
-    for (const int w : nb[v]) {
-      const double sw = s + per_length * (point(w) - point(v)).norm();
-      if (sw < size[w]) {
-        size[w] = sw;
-        queue.push({sw, w});
+  grade_from_sources(mesh, options.grade / edge_length, &size);
+  return size;
+}
+
+std::vector<double> feature_strip_vertex_size(const core::TriMesh& mesh,
+                                              const std::vector<std::array<int, 2>>& feature_edges,
+                                              double edge_length, const FeatureStripSizingOptions& options) {
+  if (!(edge_length > 0) || !(options.min_width_edges >= 0) ||
+      !(options.max_width_edges > options.min_width_edges) || !(options.max_turn_deg >= 0) ||
+      !(options.min_ratio > 0) || !(options.min_ratio <= 1) || !(options.grade > 0))
+    throw std::invalid_argument("feature_strip_vertex_size: edge_length and grade > 0, 0 <= min_width_edges < "
+                                "max_width_edges, max_turn_deg >= 0 and min_ratio in (0, 1] required");
+  const double min_cos = std::cos(options.max_turn_deg * std::numbers::pi / 180);
+  const int nv = mesh.n_vertices();
+  const std::vector<std::vector<int>> curve_nb = feature_neighbours(mesh, feature_edges, "feature_strip_vertex_size");
+  auto joined = [&](int a, int b) { return std::binary_search(curve_nb[a].begin(), curve_nb[a].end(), b); };
+  auto point = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v); };
+  std::vector<double> size(nv, 1.0);
+  for (int f = 0; f < mesh.n_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const int a = mesh.F(f, k), b = mesh.F(f, (k + 1) % 3), o = mesh.F(f, (k + 2) % 3);
+      if (!joined(a, b) || curve_nb[o].empty() || joined(o, a) || joined(o, b)) continue;
+      const Eigen::Vector3d ab = point(b) - point(a);
+      const double len = ab.norm();
+      if (!(len > 0)) continue;
+      const double width = ab.cross(point(o) - point(a)).norm() / len;
+      if (!(width >= options.min_width_edges * edge_length && width < options.max_width_edges * edge_length))
+        continue;
+      bool parallel = false;
+      for (const int w : curve_nb[o]) {
+        const Eigen::Vector3d ow = point(w) - point(o);
+        const double n = ow.norm();
+        if (n > 0 && std::abs(ow.dot(ab)) >= min_cos * n * len) parallel = true;
       }
+      if (!parallel) continue;
+      const double relative = std::max(options.min_ratio, width / edge_length);
+      for (int j = 0; j < 3; ++j) size[mesh.F(f, j)] = std::min(size[mesh.F(f, j)], relative);
     }
-  }
+  grade_from_sources(mesh, options.grade / edge_length, &size);
   return size;
 }
 

@@ -287,6 +287,29 @@ TEST(TopologyTest, AShortKnifeEdgeIsACreaseAShortFoldIsNot) {
   EXPECT_TRUE(crease_edges(fold, fold_topo, CreaseOptions{}).empty());
 }
 
+// A CAD part (the faceted cylinder's 32 rim creases) with a short fold beside it (3 sharp edges at
+// 70° between curved sides, dropped on its own): 32 of 35 sharp edges are creases, above
+// keep_all_share (0.9), so the fold is kept too.
+TEST(TopologyTest, AFewSharpEdgesBesideACadPartAreKept) {
+  const TriMesh prism = capped_prism(16);
+  const TriMesh fold = folded_strips(3, 110);
+  TriMesh both;
+  both.V.resize(prism.V.rows() + fold.V.rows(), 3);
+  both.V << prism.V, fold.V.rowwise() + Eigen::RowVector3d(5, 0, 0);
+  both.F.resize(prism.F.rows() + fold.F.rows(), 3);
+  both.F << prism.F, fold.F.array() + static_cast<int>(prism.V.rows());
+  const EdgeTopology topo = build_edge_topology(both);
+  const std::vector<int> sharp = sharp_edges(both, topo, 40);
+  ASSERT_EQ(sharp.size(), 35u);
+  EXPECT_EQ(crease_edges(both, topo, CreaseOptions{}), sharp);
+  CreaseOptions off;
+  off.keep_all_share = 1.01;
+  EXPECT_EQ(crease_edges(both, topo, off).size(), 32u) << "the fold alone is no crease";
+  CreaseOptions strict;
+  strict.keep_all_share = 0.95;  // 32 / 35 = 0.914
+  EXPECT_EQ(crease_edges(both, topo, strict).size(), 32u);
+}
+
 TEST(PredicatesTest, Orient2dSignsAndExactness) {
   EXPECT_EQ(orient2d({0, 0}, {1, 0}, {0, 1}), 1);
   EXPECT_EQ(orient2d({0, 0}, {0, 1}, {1, 0}), -1);

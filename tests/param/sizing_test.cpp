@@ -140,6 +140,74 @@ TEST(Sizing, ThinPartSizesShrinkWhereTheRadiusIsBelowAQuadEdge) {
   EXPECT_THROW((void)thin_part_vertex_size(e, 0.0), std::invalid_argument);
 }
 
+// A flat grid of n unit columns and four rows of vertices at y = −1, 0, w, w + 1, two triangles a
+// cell; the rows y = 0 and y = w are feature curves bounding a band of width w.
+struct Band {
+  core::TriMesh mesh;
+  std::vector<std::array<int, 2>> lower, upper;  // the feature rows
+  int vertex(int row, int column) const { return row * (n + 1) + column; }
+  int n = 0;
+};
+
+// The upper two rows may rise by `tilt` per unit of x (curves diverging from the lower row).
+Band band(int n, double w, double tilt = 0) {
+  Band b;
+  b.n = n;
+  const double y[4] = {-1, 0, w, w + 1};
+  b.mesh.V.resize(4 * (n + 1), 3);
+  for (int r = 0; r < 4; ++r)
+    for (int i = 0; i <= n; ++i) b.mesh.V.row(b.vertex(r, i)) << i, y[r] + (r >= 2 ? tilt * i : 0.0), 0;
+  b.mesh.F.resize(6 * n, 3);
+  for (int r = 0; r < 3; ++r)
+    for (int i = 0; i < n; ++i) {
+      const int p = b.vertex(r, i), q = b.vertex(r, i + 1), s = b.vertex(r + 1, i + 1), t = b.vertex(r + 1, i);
+      b.mesh.F.row(2 * (r * n + i)) << p, q, s;
+      b.mesh.F.row(2 * (r * n + i) + 1) << p, s, t;
+    }
+  for (int i = 0; i < n; ++i) {
+    b.lower.push_back({b.vertex(1, i), b.vertex(1, i + 1)});
+    b.upper.push_back({b.vertex(2, i), b.vertex(2, i + 1)});
+  }
+  return b;
+}
+
+TEST(Sizing, NarrowBandsBetweenFeatureCurvesGetQuadsAsLongAsTheyAreWide) {
+  FeatureStripSizingOptions o;
+  const Band narrow = band(6, 0.4);
+  std::vector<std::array<int, 2>> both = narrow.lower;
+  both.insert(both.end(), narrow.upper.begin(), narrow.upper.end());
+  // Quads of edge 1: the band is 0.4 wide, below half an edge; its vertices get 0.4, the rows one
+  // unit away 0.4 + grade.
+  const std::vector<double> s = feature_strip_vertex_size(narrow.mesh, both, 1.0, o);
+  ASSERT_EQ(static_cast<int>(s.size()), narrow.mesh.n_vertices());
+  for (int i = 0; i <= narrow.n; ++i) {
+    EXPECT_NEAR(s[narrow.vertex(1, i)], 0.4, 1e-12) << i;
+    EXPECT_NEAR(s[narrow.vertex(2, i)], 0.4, 1e-12) << i;
+    EXPECT_NEAR(s[narrow.vertex(0, i)], 0.4 + o.grade, 1e-12) << i;
+    EXPECT_NEAR(s[narrow.vertex(3, i)], 0.4 + o.grade, 1e-12) << i;
+  }
+  // Coarser quads: the floor (0.4 wide is a quarter of an edge of 1.6).
+  EXPECT_NEAR(feature_strip_vertex_size(narrow.mesh, both, 1.6, o)[narrow.vertex(1, 0)], o.min_ratio, 1e-12);
+  // A band wider than half an edge or narrower than a fifth, one curve alone, curves diverging
+  // by more than max_turn_deg (26.6°), and curves joined at the band's faces (a feature edge
+  // across it) leave the size alone.
+  for (const double x : feature_strip_vertex_size(narrow.mesh, both, 0.7, o)) EXPECT_EQ(x, 1.0);
+  for (const double x : feature_strip_vertex_size(narrow.mesh, both, 2.5, o)) EXPECT_EQ(x, 1.0);
+  const Band diverging = band(1, 0.4, 0.5);
+  const std::vector<std::array<int, 2>> diverging_curves = {diverging.lower[0], diverging.upper[0]};
+  for (const double x : feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, o)) EXPECT_EQ(x, 1.0);
+  FeatureStripSizingOptions wide_turn = o;
+  wide_turn.max_turn_deg = 30;
+  EXPECT_LT(feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, wide_turn)[diverging.vertex(1, 0)], 1.0);
+  for (const double x : feature_strip_vertex_size(narrow.mesh, narrow.lower, 1.0, o)) EXPECT_EQ(x, 1.0);
+  std::vector<std::array<int, 2>> joined = both;
+  for (int i = 0; i <= narrow.n; ++i) joined.push_back({narrow.vertex(1, i), narrow.vertex(2, i)});
+  for (int i = 0; i < narrow.n; ++i) joined.push_back({narrow.vertex(1, i), narrow.vertex(2, i + 1)});
+  for (const double x : feature_strip_vertex_size(narrow.mesh, joined, 1.0, o)) EXPECT_EQ(x, 1.0);
+  EXPECT_THROW((void)feature_strip_vertex_size(narrow.mesh, both, 0.0), std::invalid_argument);
+  EXPECT_THROW((void)feature_strip_vertex_size(narrow.mesh, {{0, 1000}}, 1.0), std::invalid_argument);
+}
+
 TEST(Sizing, ShortClosedFeatureLoopsGetSmallerQuads) {
   // The link of vertex 0 of the unit icosphere: a closed loop of feature edges around it.
   const core::TriMesh m = data_mesh("sphere.obj");

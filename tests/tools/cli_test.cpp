@@ -2,6 +2,8 @@
 // partial output on failure.
 #include "cli_run.h"
 
+#include <libcore/read_mesh.h>
+
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
@@ -398,6 +400,44 @@ TEST_F(CliTest, RemeshCapturesTheBoxCreases) {
   EXPECT_GE(with_curves["quads"]["feature_capture"].get<double>(), 0.999);
   EXPECT_EQ(with_curves["quads"]["flipped_quads"], 0);
   EXPECT_EQ(with_curves["quads"]["non_quads"], 0);
+}
+
+// --map writes the integer-seamless triangle map the quads come from: `quadify check` reads it as
+// a flip-free seamless map with integer matchings, 8 cones of index 1 at the box's corners, and a
+// UV area equal to the number of quads (each quad is a unit square of the grid).
+TEST_F(CliTest, RemeshWritesTheIntegerMapOnRequest) {
+  const fs::path map = dir_ / "box_map.obj";
+  const auto report = remesh_report(data_path("box.obj"), 200, "--map '" + map.string() + "'");
+  ASSERT_TRUE(fs::exists(map));
+  EXPECT_EQ(report["map_output"], map.string());
+  const CliRun c = quadify("check '" + map.string() + "' --json '" + (dir_ / "c.json").string() + "'", dir_);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const auto j = nlohmann::json::parse(slurp(dir_ / "c.json"))["check"];
+  EXPECT_EQ(j["kind"], "uv");
+  EXPECT_EQ(j["flipped"], 0);
+  EXPECT_EQ(j["matchings_integer"], true);
+  EXPECT_EQ(j["seam_residual_abs"].get<double>(), 0.0) << "integer-seamless to the bit";
+  EXPECT_EQ(j["cones"], 8);
+  EXPECT_EQ(j["cone_index_sum"], 8);
+  const quadify::core::PolyMesh read = quadify::core::read_mesh(map);
+  ASSERT_TRUE(read.has_uv());
+  double uv_area = 0;
+  for (int f = 0; f < read.n_faces(); ++f) {
+    const Eigen::Vector2d a = read.uv.row(read.face_uv[read.face_corner(f, 0)]);
+    const Eigen::Vector2d b = read.uv.row(read.face_uv[read.face_corner(f, 1)]);
+    const Eigen::Vector2d c = read.uv.row(read.face_uv[read.face_corner(f, 2)]);
+    uv_area += 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+  }
+  EXPECT_NEAR(uv_area, report["quads"]["faces"].get<double>(), 1e-6);
+  // Without --map no map is written, and an unwritable map path fails before the run.
+  const fs::path bad = dir_ / "missing_dir" / "m.obj";
+  std::string args;  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on "'" + string
+  args.append("'").append(data_path("box.obj").string()).append("' -o '").append((dir_ / "b.obj").string());
+  args.append("' --quiet --map '").append(bad.string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find(bad.string() + ": cannot create file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "b.obj"));
 }
 
 // Creases that are all short (--min-crease-quads above the box's network, 72 edges in one

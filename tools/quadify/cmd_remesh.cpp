@@ -29,6 +29,7 @@ struct RemeshArgs {
   int target_faces = 0;
   double edge_length = 0;
   bool keep_uv = false;
+  std::string map_output;  // the integer-seamless triangle map as a UV OBJ ("" = none)
   bool measure = true;
   bool relax = true;
   bool feature_snap = true;
@@ -110,6 +111,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
 
 int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   core::check_can_write(args.output);
+  if (!args.map_output.empty()) core::check_can_write(args.map_output);
   Progress progress(common.quiet);
   LoadedMesh loaded = load_and_repair(args.input, progress);
   const core::TriMesh& mesh = loaded.repaired.mesh;
@@ -120,6 +122,7 @@ int run_remesh(const RemeshArgs& args, const CommonOptions& common) {
   report["repair"] = to_json(loaded.repaired.report);
   report["mesh"] = to_json(core::topology_stats(mesh));
   report["output"] = args.output;
+  if (!args.map_output.empty()) report["map_output"] = args.map_output;
   // A failure after this point still writes the report (status "error", the message, and the
   // figures of the stages that ran), but no mesh.
   try {
@@ -205,21 +208,33 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     param_options.feature_edges = quantize::features_for_density(mesh, param_options.feature_edges, quantize_options);
     feature_input.n_too_small = static_cast<int>(before - param_options.feature_edges.size());
   }
-  // Feature-loop sizing: without sizes of the user's, quads shrink around closed feature curves
-  // too short for 12 quad edges, small holes' rims (param::feature_loop_vertex_size; the count
-  // stays).
-  std::vector<double> loop_size;
+  // Feature sizing: without sizes of the user's, quads shrink around closed feature curves too
+  // short for 12 quad edges, small holes' rims (param::feature_loop_vertex_size), and along bands
+  // narrower than half a quad between two feature curves (param::feature_strip_vertex_size); the
+  // count stays.
+  std::vector<double> loop_size;  // the smaller of both
+  std::string feature_sizing_mode;
   if (args.feature_sizing && sizing.face_size.empty() && sizing.face_metric.empty() &&
       !param_options.feature_edges.empty()) {
     loop_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
+    const std::vector<double> strip_size =
+        param::feature_strip_vertex_size(mesh, param_options.feature_edges, quad_edge);
+    auto sized = [](const std::vector<double>& s) {
+      return std::count_if(s.begin(), s.end(), [](double x) { return x < 1; });
+    };
+    const auto loop_vertices = sized(loop_size), strip_vertices = sized(strip_size);
+    feature_sizing_mode = loop_vertices > 0 && strip_vertices > 0 ? "feature-loops+strips"
+                          : strip_vertices > 0                    ? "feature-strips"
+                                                                  : "feature-loops";
+    for (size_t v = 0; v < loop_size.size(); ++v) loop_size[v] = std::min(loop_size[v], strip_size[v]);
     const double smallest = *std::min_element(loop_size.begin(), loop_size.end());
     if (smallest < 1) {
       sizing.face_size = param::face_size_from_vertices(mesh, loop_size);
       const auto [lo, hi] = std::minmax_element(sizing.face_size.begin(), sizing.face_size.end());
-      sizing.report = {{"mode", "feature-loops"},
+      sizing.report = {{"mode", feature_sizing_mode},
                        {"smallest_relative_edge", number(smallest)},
-                       {"sized_vertices", std::count_if(loop_size.begin(), loop_size.end(),
-                                                        [](double s) { return s < 1; })},
+                       {"sized_vertices", sized(loop_size)},
+                       {"strip_vertices", strip_vertices},
                        {"min", number(*lo)},
                        {"max", number(*hi)}};
       sizing.apply_to(&param_options);
@@ -433,7 +448,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       std::vector<double> sizes = thin;  // with the feature-loop sizes, where smaller
       for (size_t v = 0; v < loop_size.size(); ++v) sizes[v] = std::min(sizes[v], loop_size[v]);
       sizing.face_size = param::face_size_from_vertices(mesh, sizes);
-      sizing.report = {{"mode", loop_size.empty() ? "thin-parts" : "thin-parts+feature-loops"},
+      sizing.report = {{"mode", loop_size.empty() ? "thin-parts" : "thin-parts+" + feature_sizing_mode},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
                        {"thin_area_share", number(thin_area / area)}};
@@ -581,6 +596,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   }
 
   progress.begin("write");
+  if (!args.map_output.empty()) core::write_uv_obj(args.map_output, integer_map.uv);
   core::write_mesh(args.output, extracted.quads);
   progress.end();
 
@@ -734,12 +750,19 @@ CommandRunner register_remesh(CLI::App& app) {
                "the target edge where the radius of curvature is below it, the count kept; sizing.mode "
                "\"thin-parts\" in the report)");
   app.add_flag("!--no-feature-sizing", args->feature_sizing,
-               "Keep the quad size uniform around short closed feature curves (by default, without "
-               "--adaptive or --size-field: a closed crease or boundary loop less than 12 target quad "
-               "edges long, such as a small hole's rim, gets 12 quads around, down to 0.3 of the target "
-               "edge, growing back by a quarter per quad edge; the count kept; sizing.mode "
-               "\"feature-loops\" in the report)");
+               "Keep the quad size uniform around short closed feature curves and narrow feature bands "
+               "(by default, without --adaptive or --size-field: a closed crease or boundary loop less "
+               "than 12 target quad edges long, such as a small hole's rim, gets 12 quads around, and a "
+               "band narrower than half a quad edge between two creases, such as a narrow chamfer, gets "
+               "quads as long as it is wide, down to 0.3 of the target edge, growing back by a quarter "
+               "per quad edge; the count kept; sizing.mode \"feature-loops\", \"feature-strips\" or "
+               "\"feature-loops+strips\" in the report)");
   app.add_flag("--uv", args->keep_uv, "Keep the integer UVs as per-corner texture coordinates in the output");
+  app.add_option("--map", args->map_output,
+                 "Also write the integer-seamless map the quads were extracted from: the repaired input "
+                 "triangles with per-corner integer-grid UVs, as an OBJ (quad edges are its integer "
+                 "iso-lines; `quadify check` measures it)")
+      ->type_name("MAP.obj");
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "
                "scaled Jacobian below 0.2 are relaxed on the input surface)");
