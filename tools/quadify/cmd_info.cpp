@@ -38,6 +38,11 @@ int run_info(const std::string& input, const CommonOptions& common) {
   const core::TopologyStats raw_stats = core::topology_stats(core::to_trimesh(loaded.raw));
   const core::TopologyStats stats = core::topology_stats(loaded.repaired.mesh);
   const EdgeLengths lengths = edge_lengths(loaded.repaired.mesh);
+  // The sharp edges the remesher would align at its defaults (--feature-angle 40, the crease filter).
+  const core::EdgeTopology topo = core::build_edge_topology(loaded.repaired.mesh);
+  const core::CreaseOptions crease;
+  const size_t n_sharp = core::sharp_edges(loaded.repaired.mesh, topo, crease.angle_deg).size();
+  const size_t n_creases = core::crease_edges(loaded.repaired.mesh, topo, crease).size();
   progress.end();
 
   const core::RepairReport& r = loaded.repaired.report;
@@ -55,6 +60,10 @@ int run_info(const std::string& input, const CommonOptions& common) {
               stats.euler_characteristic, stats.genus >= 0 ? std::to_string(stats.genus).c_str() : "undefined");
   std::printf("size: bbox diagonal %.6g, edge length min %.4g mean %.4g max %.4g\n",
               core::bbox_diagonal(loaded.repaired.mesh.V), lengths.min, lengths.mean, lengths.max);
+  std::printf("features: %zu sharp edges (dihedral angle above %g degrees), %zu of them creases: what the "
+              "remesher aligns at its defaults, less curves too short for the quad size%s\n",
+              n_sharp, crease.angle_deg, n_creases,
+              n_creases == n_sharp ? "" : " (the others are scattered or faceted: see --feature-side-angle)");
 
   nlohmann::json report;
   report["command"] = "info";
@@ -64,6 +73,8 @@ int run_info(const std::string& input, const CommonOptions& common) {
   report["repair"] = to_json(r);
   report["mesh"] = to_json(stats);
   report["mesh"]["edge_length"] = {{"min", lengths.min}, {"mean", lengths.mean}, {"max", lengths.max}};
+  report["mesh"]["sharp_edges"] = n_sharp;
+  report["mesh"]["crease_edges"] = n_creases;
   report["timings"] = progress.timings();
   write_report(common, report);
   return kExitOk;
