@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -596,8 +597,15 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   }
 
   progress.begin("write");
+  // The map first; should the mesh then fail to write, the map goes too (no partial output).
   if (!args.map_output.empty()) core::write_uv_obj(args.map_output, integer_map.uv);
-  core::write_mesh(args.output, extracted.quads);
+  try {
+    core::write_mesh(args.output, extracted.quads);
+  } catch (...) {
+    std::error_code ec;
+    if (!args.map_output.empty()) std::filesystem::remove(args.map_output, ec);
+    throw;
+  }
   progress.end();
 
   report["param"] = param_json(seamless);
