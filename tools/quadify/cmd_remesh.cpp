@@ -414,6 +414,15 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                    core::topology_stats(mesh).n_boundary_loops > 0 ? " --no-boundary-alignment" : "");
     param_options.feature_edges.clear();
     param_options.align_boundaries = false;
+    // The feature sizing goes with the features (mannequin-devil at 5,000 quads: quads shrunk
+    // along bands of creases no longer aligned, Hausdorff 0.0082 → 0.0137).
+    if (!loop_size.empty()) {
+      loop_size.clear();
+      sizing.face_size.clear();
+      sizing.report = {{"mode", "uniform"}, {"feature_sizing_dropped", feature_sizing_mode}};
+      sizing.apply_to(&param_options);
+      quantize_options.face_size.clear();
+    }
     seamless = parametrize(param_options);
     coarsen();
     integer_map = quantize_map(seamless);
