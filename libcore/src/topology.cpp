@@ -308,7 +308,8 @@ std::vector<int> crease_edges(const TriMesh& mesh, const EdgeTopology& topo, con
     const int g = find(topo.edge_vertex(e, 0));
     if (keep[e] && (n_kept[g] >= options.min_group_edges || sharp_group[g])) creases.push_back(e);
   }
-  if (static_cast<double>(creases.size()) >= options.keep_all_share * static_cast<double>(sharp.size())) return sharp;
+  const double kept_share = static_cast<double>(creases.size()) / static_cast<double>(sharp.size());
+  if (kept_share >= options.keep_all_share) return sharp;
   return creases;
 }
 

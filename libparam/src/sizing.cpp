@@ -198,7 +198,6 @@ std::vector<double> thin_part_vertex_size(const core::TriMesh& mesh, double edge
   return size;
 }
 
-
 std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
                                               const std::vector<std::array<int, 2>>& feature_edges,
                                               double edge_length, const FeatureLoopSizingOptions& options) {
@@ -207,7 +206,8 @@ std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
     throw std::invalid_argument("feature_loop_vertex_size: edge_length, min_loop_edges and grade > 0 and "
                                 "min_ratio in (0, 1] required");
   const int nv = mesh.n_vertices();
-  const std::vector<std::vector<int>> curve_nb = feature_neighbours(mesh, feature_edges, "feature_loop_vertex_size");
+  const std::vector<std::vector<int>> curve_nb =
+      feature_neighbours(mesh, feature_edges, "feature_loop_vertex_size");
   auto point = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v); };
   // Closed loops: connected sets of curve vertices that all lie on exactly two curve edges.
   std::vector<double> size(nv, 1.0);
@@ -231,9 +231,7 @@ std::vector<double> feature_loop_vertex_size(const core::TriMesh& mesh,
     }
     const double relative = length / (options.min_loop_edges * edge_length);
     if (!closed || !(relative < 1)) continue;
-    for (const int v : loop) {
-      size[v] = std::max(options.min_ratio, relative);
-    }
+    for (const int v : loop) size[v] = std::max(options.min_ratio, relative);
   }
   grade_from_sources(mesh, options.grade / edge_length, &size);
   return size;
@@ -245,12 +243,16 @@ std::vector<double> feature_strip_vertex_size(const core::TriMesh& mesh,
   if (!(edge_length > 0) || !(options.min_width_edges >= 0) ||
       !(options.max_width_edges > options.min_width_edges) || !(options.max_turn_deg >= 0) ||
       !(options.min_ratio > 0) || !(options.min_ratio <= 1) || !(options.grade > 0))
-    throw std::invalid_argument("feature_strip_vertex_size: edge_length and grade > 0, 0 <= min_width_edges < "
-                                "max_width_edges, max_turn_deg >= 0 and min_ratio in (0, 1] required");
+    throw std::invalid_argument(
+        "feature_strip_vertex_size: edge_length and grade > 0, 0 <= min_width_edges < "
+        "max_width_edges, max_turn_deg >= 0 and min_ratio in (0, 1] required");
   const double min_cos = std::cos(options.max_turn_deg * std::numbers::pi / 180);
   const int nv = mesh.n_vertices();
-  const std::vector<std::vector<int>> curve_nb = feature_neighbours(mesh, feature_edges, "feature_strip_vertex_size");
-  auto joined = [&](int a, int b) { return std::binary_search(curve_nb[a].begin(), curve_nb[a].end(), b); };
+  const std::vector<std::vector<int>> curve_nb =
+      feature_neighbours(mesh, feature_edges, "feature_strip_vertex_size");
+  auto joined = [&](int a, int b) {
+    return std::binary_search(curve_nb[a].begin(), curve_nb[a].end(), b);
+  };
   auto point = [&](int v) -> Eigen::Vector3d { return mesh.V.row(v); };
   std::vector<double> size(nv, 1.0);
   for (int f = 0; f < mesh.n_faces(); ++f)
@@ -261,7 +263,8 @@ std::vector<double> feature_strip_vertex_size(const core::TriMesh& mesh,
       const double len = ab.norm();
       if (!(len > 0)) continue;
       const double width = ab.cross(point(o) - point(a)).norm() / len;
-      if (!(width >= options.min_width_edges * edge_length && width < options.max_width_edges * edge_length))
+      if (!(width >= options.min_width_edges * edge_length &&
+            width < options.max_width_edges * edge_length))
         continue;
       bool parallel = false;
       for (const int w : curve_nb[o]) {

@@ -160,7 +160,8 @@ Band band(int n, double w, double tilt = 0) {
   b.mesh.F.resize(6 * n, 3);
   for (int r = 0; r < 3; ++r)
     for (int i = 0; i < n; ++i) {
-      const int p = b.vertex(r, i), q = b.vertex(r, i + 1), s = b.vertex(r + 1, i + 1), t = b.vertex(r + 1, i);
+      const int p = b.vertex(r, i), q = b.vertex(r, i + 1);
+      const int s = b.vertex(r + 1, i + 1), t = b.vertex(r + 1, i);
       b.mesh.F.row(2 * (r * n + i)) << p, q, s;
       b.mesh.F.row(2 * (r * n + i) + 1) << p, s, t;
     }
@@ -195,10 +196,12 @@ TEST(Sizing, NarrowBandsBetweenFeatureCurvesGetQuadsAsLongAsTheyAreWide) {
   for (const double x : feature_strip_vertex_size(narrow.mesh, both, 2.5, o)) EXPECT_EQ(x, 1.0);
   const Band diverging = band(1, 0.4, 0.5);
   const std::vector<std::array<int, 2>> diverging_curves = {diverging.lower[0], diverging.upper[0]};
-  for (const double x : feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, o)) EXPECT_EQ(x, 1.0);
+  for (const double x : feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, o))
+    EXPECT_EQ(x, 1.0);
   FeatureStripSizingOptions wide_turn = o;
   wide_turn.max_turn_deg = 30;
-  EXPECT_LT(feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, wide_turn)[diverging.vertex(1, 0)], 1.0);
+  const std::vector<double> wide = feature_strip_vertex_size(diverging.mesh, diverging_curves, 1.0, wide_turn);
+  EXPECT_LT(wide[diverging.vertex(1, 0)], 1.0);
   for (const double x : feature_strip_vertex_size(narrow.mesh, narrow.lower, 1.0, o)) EXPECT_EQ(x, 1.0);
   std::vector<std::array<int, 2>> joined = both;
   for (int i = 0; i <= narrow.n; ++i) joined.push_back({narrow.vertex(1, i), narrow.vertex(2, i)});
