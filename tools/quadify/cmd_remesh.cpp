@@ -213,35 +213,36 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // short for 12 quad edges, small holes' rims (param::feature_loop_vertex_size), and along bands
   // narrower than half a quad between two feature curves (param::feature_strip_vertex_size); the
   // count stays.
-  std::vector<double> loop_size;  // the smaller of both
+  std::vector<double> feature_size;  // per vertex, the smaller of the loops' and the strips'
   std::string feature_sizing_mode;
   if (args.feature_sizing && sizing.face_size.empty() && sizing.face_metric.empty() &&
       !param_options.feature_edges.empty()) {
-    loop_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
+    feature_size = param::feature_loop_vertex_size(mesh, param_options.feature_edges, quad_edge);
     const std::vector<double> strip_size =
         param::feature_strip_vertex_size(mesh, param_options.feature_edges, quad_edge);
     auto sized = [](const std::vector<double>& s) {
       return std::count_if(s.begin(), s.end(), [](double x) { return x < 1; });
     };
-    const auto loop_vertices = sized(loop_size), strip_vertices = sized(strip_size);
+    const auto loop_vertices = sized(feature_size), strip_vertices = sized(strip_size);
     feature_sizing_mode = loop_vertices > 0 && strip_vertices > 0 ? "feature-loops+strips"
                           : strip_vertices > 0                    ? "feature-strips"
                                                                   : "feature-loops";
-    for (size_t v = 0; v < loop_size.size(); ++v) loop_size[v] = std::min(loop_size[v], strip_size[v]);
-    const double smallest = *std::min_element(loop_size.begin(), loop_size.end());
+    for (size_t v = 0; v < feature_size.size(); ++v)
+      feature_size[v] = std::min(feature_size[v], strip_size[v]);
+    const double smallest = *std::min_element(feature_size.begin(), feature_size.end());
     if (smallest < 1) {
-      sizing.face_size = param::face_size_from_vertices(mesh, loop_size);
+      sizing.face_size = param::face_size_from_vertices(mesh, feature_size);
       const auto [lo, hi] = std::minmax_element(sizing.face_size.begin(), sizing.face_size.end());
       sizing.report = {{"mode", feature_sizing_mode},
                        {"smallest_relative_edge", number(smallest)},
-                       {"sized_vertices", sized(loop_size)},
+                       {"sized_vertices", sized(feature_size)},
                        {"strip_vertices", strip_vertices},
                        {"min", number(*lo)},
                        {"max", number(*hi)}};
       sizing.apply_to(&param_options);
       quantize_options.face_size = sizing.face_size;
     } else {
-      loop_size.clear();
+      feature_size.clear();
     }
   }
   // The report's param and quantize sections, written as soon as a stage has run.
@@ -370,7 +371,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       std::max(kMinFeatureSeconds, kFeatureTimeFactor * seamless.stats.seconds_total);
   // Thin parts (see the retry below): the field, computed at the first dead end that needs it.
   const bool thin_retry_allowed =
-      args.thin_parts && (sizing.face_size.empty() || !loop_size.empty()) && sizing.face_metric.empty();
+      args.thin_parts && (sizing.face_size.empty() || !feature_size.empty()) && sizing.face_metric.empty();
   std::vector<double> thin;
   auto thin_field = [&]() -> const std::vector<double>& {
     if (thin.empty()) thin = param::thin_part_vertex_size(mesh, quad_edge);
@@ -416,8 +417,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     param_options.align_boundaries = false;
     // The feature sizing goes with the features (mannequin-devil at 5,000 quads: quads shrunk
     // along bands of creases no longer aligned, Hausdorff 0.0082 → 0.0137).
-    if (!loop_size.empty()) {
-      loop_size.clear();
+    if (!feature_size.empty()) {
+      feature_size.clear();
       sizing.face_size.clear();
       sizing.report = {{"mode", "uniform"}, {"feature_sizing_dropped", feature_sizing_mode}};
       sizing.apply_to(&param_options);
@@ -455,10 +456,10 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      "the quads (radius of curvature below a quad edge): parametrizing again with quads "
                      "down to %.2f times as long there\n",
                      args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
-      std::vector<double> sizes = thin;  // with the feature-loop sizes, where smaller
-      for (size_t v = 0; v < loop_size.size(); ++v) sizes[v] = std::min(sizes[v], loop_size[v]);
+      std::vector<double> sizes = thin;  // with the feature sizes, where smaller
+      for (size_t v = 0; v < feature_size.size(); ++v) sizes[v] = std::min(sizes[v], feature_size[v]);
       sizing.face_size = param::face_size_from_vertices(mesh, sizes);
-      sizing.report = {{"mode", loop_size.empty() ? "thin-parts" : "thin-parts+" + feature_sizing_mode},
+      sizing.report = {{"mode", feature_size.empty() ? "thin-parts" : "thin-parts+" + feature_sizing_mode},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
                        {"thin_area_share", number(thin_area / area)}};
