@@ -196,6 +196,10 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
   for (int f = 0; f < nf; ++f) {
     ++m.faces_by_degree[quads.degree(f)];
     if (quads.degree(f) != 4) ++m.n_non_quads;
+    std::vector<int> corners(quads.face_vertex.begin() + quads.face_offset[f],
+                             quads.face_vertex.begin() + quads.face_offset[f + 1]);
+    std::sort(corners.begin(), corners.end());
+    if (std::adjacent_find(corners.begin(), corners.end()) != corners.end()) ++m.n_degenerate;
   }
 
   // Undirected edges with their half-edges (face corner ids of the tails).
@@ -248,7 +252,7 @@ QuadMetrics compute_quad_metrics(const core::PolyMesh& quads, const core::TriMes
   for (size_t c = 0; c < quads.face_vertex.size(); ++c)
     if (corner_sets.find(static_cast<int>(c)) == static_cast<int>(c)) ++fans[quads.face_vertex[c]];
   const bool vertex_manifold = std::none_of(fans.begin(), fans.end(), [](int n) { return n > 1; });
-  m.manifold = edge_manifold && vertex_manifold;
+  m.manifold = edge_manifold && vertex_manifold && m.n_degenerate == 0;
 
   for (int v = 0; v < nv; ++v) {
     if (!used[v]) continue;

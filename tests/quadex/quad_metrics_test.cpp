@@ -160,6 +160,24 @@ TEST(QuadMetrics, NonManifoldEdgeAndVertex) {
   EXPECT_EQ(vertex.n_components, 2);
 
   EXPECT_TRUE(compute_quad_metrics(quad_grid(2)).manifold);
+  EXPECT_EQ(compute_quad_metrics(quad_grid(2)).n_degenerate, 0);
+}
+
+// A quad that visits a vertex twice: an iso-line that closes on its own grid point (a handle one
+// quad around) gives a loop edge (2, 2); a pinched quad visits its vertex at opposite corners.
+TEST(QuadMetrics, FacesVisitingAVertexTwiceAreNotManifold) {
+  core::PolyMesh loop = quad_grid(2);
+  loop.add_face({8, 5, 2, 2});
+  const QuadMetrics with_loop = compute_quad_metrics(loop);
+  EXPECT_EQ(with_loop.n_degenerate, 1);
+  EXPECT_FALSE(with_loop.manifold);
+  EXPECT_EQ(with_loop.genus, -1);
+
+  core::PolyMesh pinched = quad_grid(1);
+  pinched.add_face({1, 4, 1, 5});
+  const QuadMetrics with_pinch = compute_quad_metrics(pinched);
+  EXPECT_EQ(with_pinch.n_degenerate, 1);
+  EXPECT_FALSE(with_pinch.manifold);
 }
 
 TEST(QuadMetrics, HausdorffAgainstItselfIsZero) {

@@ -106,9 +106,11 @@ nlohmann::json check_quads(const CheckArgs& args, const core::PolyMesh& raw, Pro
   nlohmann::json degrees = nlohmann::json::object(), valences = nlohmann::json::object();
   for (auto [d, n] : m.faces_by_degree) degrees[std::to_string(d)] = n;
   for (auto [v, n] : m.valence_histogram) valences[std::to_string(v)] = n;
-  std::printf("%s: %d vertices, %d faces (%d not quads), %s, %d components, %d boundary loops, chi %d\n",
+  const std::string degenerate =
+      m.n_degenerate > 0 ? " (" + std::to_string(m.n_degenerate) + " faces visit a vertex twice)" : "";
+  std::printf("%s: %d vertices, %d faces (%d not quads), %s%s, %d components, %d boundary loops, chi %d\n",
               args.file.c_str(), m.n_vertices, m.n_faces, m.n_non_quads, m.manifold ? "manifold" : "NOT manifold",
-              m.n_components, m.n_boundary_loops, m.euler_characteristic);
+              degenerate.c_str(), m.n_components, m.n_boundary_loops, m.euler_characteristic);
   std::printf("irregular vertices %d, flipped quads %d, scaled Jacobian min %.3f mean %.3f, angle deviation mean %.2f deg, "
               "edge length CV %.3f\n",
               m.n_irregular, m.n_flipped, m.sj_min, m.sj_mean, m.angle_dev_mean, m.edge_len_cv);
@@ -131,6 +133,7 @@ nlohmann::json check_quads(const CheckArgs& args, const core::PolyMesh& raw, Pro
   j["non_quads"] = m.n_non_quads;
   j["valence_histogram"] = valences;
   j["irregular_vertices"] = m.n_irregular;
+  j["degenerate_faces"] = m.n_degenerate;
   j["manifold"] = m.manifold;
   j["components"] = m.n_components;
   j["boundary_loops"] = m.n_boundary_loops;

@@ -477,6 +477,7 @@ nlohmann::json row_json(const std::string& model, const std::string& tool, const
   j["faces_by_degree"] = degrees;
   j["irregular_vertices"] = m.n_irregular;
   j["valence_histogram"] = valences;
+  j["degenerate_faces"] = m.n_degenerate;
   j["manifold"] = m.manifold;
   j["components"] = m.n_components;
   j["genus"] = m.genus;

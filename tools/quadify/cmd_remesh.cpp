@@ -652,6 +652,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"non_quads", m.n_non_quads},
                        {"irregular_vertices", m.n_irregular},
                        {"flipped_quads", m.n_flipped},
+                       {"degenerate_faces", m.n_degenerate},
                        {"manifold", m.manifold},
                        {"components", m.n_components},
                        {"genus", m.genus},

@@ -29,6 +29,9 @@ struct QuadMetrics {
   int n_non_quads = 0;
   std::map<int, int> valence_histogram;  // interior vertex valence → count
   int n_irregular = 0;      // interior valence ≠ 4; boundary valence ≠ 3 except corners (valence 2)
+  // Faces that visit a vertex more than once (a loop edge, as an iso-line around a handle one
+  // quad thick gives, or a pinched polygon): such a mesh is not manifold.
+  int n_degenerate = 0;
   bool manifold = false;
   int n_components = 0;
   int n_boundary_loops = 0;
