@@ -519,6 +519,8 @@ TEST_F(CliTest, RemeshSplitsAComponentTooSmallForTheGrid) {
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
   EXPECT_EQ(report["small_components"]["replaced"], 1);
   EXPECT_EQ(report["small_components"]["quads_added"], 24);
+  // The flake's own faces are no reason to refine the torus's grid.
+  EXPECT_EQ(report["quantize"]["refinements"], 0);
 }
 
 // A flake of 162 triangles is more than the split takes (64): it gets no quads, and the

@@ -547,8 +547,23 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // where the repair split a non-manifold edge or vertex are kept as they are).
   const bool manifold_input = loaded.repaired.report.nonmanifold_edges_split == 0 &&
                               loaded.repaired.report.nonmanifold_vertices_split == 0;
-  for (; refinements < kMaxRefinements && manifold_input &&
-         !quadex::compute_quad_metrics(extracted.quads).manifold;
+  // Components too small for the grid (degenerate or non-quad faces): their triangles split.
+  auto split_small = [&](const quantize::QuantizeResult& map, const quadex::ExtractResult& ex) {
+    quadex::SmallComponentOptions small_options;
+    small_options.replace_faces = map.stats.faces_with_unresolved_cones;
+    quadex::SmallComponentResult small =
+        quadex::split_small_components(map.uv, ex.quads, ex.vertex_face, small_options);
+    if (!small.status.is_ok())
+      throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
+    return small;
+  };
+  // Whether the quads are manifold once the small components are split (their degenerate faces
+  // are no reason to refine the whole grid).
+  auto kept_manifold = [&](const quantize::QuantizeResult& map, const quadex::ExtractResult& ex) {
+    const quadex::SmallComponentResult small = split_small(map, ex);
+    return quadex::compute_quad_metrics(small.stats.n_replaced > 0 ? small.quads : ex.quads).manifold;
+  };
+  for (; refinements < kMaxRefinements && manifold_input && !kept_manifold(integer_map, extracted);
        ++refinements) {
     const int faces_before = extracted.stats.n_faces;
     refine_density(mesh, &quantize_options);
@@ -564,13 +579,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     integer_map = std::move(finer);
     extracted = std::move(finer_quads);
   }
-  // Components too small for the grid (degenerate or non-quad faces): their triangles split.
-  quadex::SmallComponentOptions small_options;
-  small_options.replace_faces = integer_map.stats.faces_with_unresolved_cones;
-  quadex::SmallComponentResult small =
-      quadex::split_small_components(integer_map.uv, extracted.quads, extracted.vertex_face, small_options);
-  if (!small.status.is_ok())
-    throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
+  quadex::SmallComponentResult small = split_small(integer_map, extracted);
   if (small.stats.n_replaced > 0) {
     extracted.quads = std::move(small.quads);
     if (!common.quiet) {
