@@ -173,7 +173,7 @@ TEST(QuadMetrics, FacesVisitingAVertexTwiceAreNotManifold) {
   EXPECT_FALSE(with_loop.manifold);
   EXPECT_EQ(with_loop.genus, -1);
 
-  core::PolyMesh pinched = quad_grid(1);
+  core::PolyMesh pinched = quad_grid(2);
   pinched.add_face({1, 4, 1, 5});
   const QuadMetrics with_pinch = compute_quad_metrics(pinched);
   EXPECT_EQ(with_pinch.n_degenerate, 1);
