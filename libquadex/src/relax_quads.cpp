@@ -439,20 +439,14 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
   // by one task.
   std::vector<std::vector<QuadMemo>> distance_memo(static_cast<size_t>(nf));
   auto quad_distance = [&](int f, int n = kFitQuadSamples, int first = 0) {
-    QuadMemo scratch;  // a face of another degree is measured each time
-    QuadMemo* memo = &scratch;
+    QuadMemo* memo = nullptr;  // none for a face of another degree: measured each time
+    CornerKey key;
     if (q.degree(f) == 4) {
-      memo = nullptr;
+      key = corner_key(q, f);
       for (QuadMemo& m : distance_memo[f])
         if (m.samples == n && m.first == first) memo = &m;
-      if (!memo) {
-        memo = &distance_memo[f].emplace_back();
-        memo->samples = n;
-        memo->first = first;
-      }
-      scratch.key = corner_key(q, f);
-      if (memo->valid && memo->key == scratch.key) return memo->value;
-      memo->key = scratch.key;
+      if (memo && memo->valid && memo->key == key) return memo->value;
+      if (!memo) memo = &distance_memo[f].emplace_back();
     }
     double worst = 0;
     for (int t = 0; t < 2; ++t) {
@@ -464,9 +458,9 @@ RelaxResult relax_bad_quads(const core::PolyMesh& quads, const core::TriMesh& su
           worst = std::max(worst, tree.squared_distance(p));
         }
     }
-    memo->value = std::sqrt(worst);
-    memo->valid = true;
-    return memo->value;
+    const double value = std::sqrt(worst);
+    if (memo) *memo = {key, value, true, n, first};
+    return value;
   };
   // Distance from the surface up to which a snap may take a vertex's quads (set below).
   double snap_distance_allowed = 0;

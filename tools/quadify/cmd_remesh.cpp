@@ -557,13 +557,14 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       throw CliError{kExitInternal, args.input + ": small components: " + small.status.to_string()};
     return small;
   };
-  // Whether the quads are manifold once the small components are split (their degenerate faces
-  // are no reason to refine the whole grid).
-  auto kept_manifold = [&](const quantize::QuantizeResult& map, const quadex::ExtractResult& ex) {
-    const quadex::SmallComponentResult small = split_small(map, ex);
-    return quadex::compute_quad_metrics(small.stats.n_replaced > 0 ? small.quads : ex.quads).manifold;
+  quadex::SmallComponentResult small = split_small(integer_map, extracted);
+  // The quads must be manifold once the small components are split (their degenerate faces are no
+  // reason to refine the whole grid).
+  auto kept_quads = [&]() -> const core::PolyMesh& {
+    return small.stats.n_replaced > 0 ? small.quads : extracted.quads;
   };
-  for (; refinements < kMaxRefinements && manifold_input && !kept_manifold(integer_map, extracted);
+  for (; refinements < kMaxRefinements && manifold_input &&
+         !quadex::compute_quad_metrics(kept_quads()).manifold;
        ++refinements) {
     const int faces_before = extracted.stats.n_faces;
     refine_density(mesh, &quantize_options);
@@ -578,8 +579,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                    args.input.c_str(), faces_before, finer_quads.stats.n_faces);
     integer_map = std::move(finer);
     extracted = std::move(finer_quads);
+    small = split_small(integer_map, extracted);
   }
-  quadex::SmallComponentResult small = split_small(integer_map, extracted);
   if (small.stats.n_replaced > 0) {
     extracted.quads = std::move(small.quads);
     if (!common.quiet) {
