@@ -13,6 +13,7 @@
 #endif
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstdio>
 #include <cmath>
 #include <cstdint>
@@ -1021,6 +1022,8 @@ PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
   const size_t nt = targets.size();
   rep.pinned.assign(nt, 0);
   rep.blocking.assign(nt, 0);
+  // A call without penalty stages that pins nothing leaves the layout as it found it (see the end).
+  const Eigen::VectorXd y_start = m.y, x_start = m.x;
   std::vector<char> active(nt, 0);
   for (size_t i = 0; i < nt; ++i) {
     const int j = targets[i].first;
@@ -1244,6 +1247,18 @@ PinReport PinnedLayout::pin(const std::vector<std::pair<int, double>>& targets,
     } else {
       m.state[j] = 0;
     }
+  }
+  // Nothing pinned by plain steps: they are undone instead of relaxed from. The layout was
+  // relaxed before the call, and relaxing a layout pushed against a barrier takes up to
+  // relax_iterations Newton steps, so a failed attempt cost ~5× a successful one (beetle at 5,000
+  // quads: pin iterations 580 → 367). After the penalty homotopy the layout is near a minimum
+  // already, its relaxation is short, and the next attempt starts better from it than from the
+  // layout before (mask: 198 pin iterations kept; undone, 217).
+  if (settings.penalty_stages == 0 && rep.status.is_ok() &&
+      std::none_of(rep.pinned.begin(), rep.pinned.end(), [](char p) { return p != 0; })) {
+    m.y = y_start;
+    m.x = x_start;
+    return rep;
   }
   if (rep.status.is_ok() && relax_iterations > 0) {
     core::Status st;

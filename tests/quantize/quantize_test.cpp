@@ -587,6 +587,44 @@ TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
   EXPECT_EQ(layout.n_flipped(), 0);
 }
 
+TEST(PinnedLayout, AnAttemptThatPinsNothingLeavesTheLayoutAsItWas) {
+  SphereLayout sphere;
+  auto& [mesh, cl, layout, ready] = sphere;
+  ASSERT_TRUE(ready);
+  const param::ConstrainedReduction& red = layout.reduction();
+  const std::vector<int> col_of = column_of_variable(red);
+  int copy = -1;
+  for (int k = 0; k < cl.n_copies() && copy < 0; ++k)
+    if (col_of[2 * k] >= 0) copy = k;
+  ASSERT_GE(copy, 0);
+  const int j = col_of[2 * copy];
+  // A hundred units away: the steps move the layout towards it until the faces around the copy
+  // stop them, and the target is dropped.
+  const Eigen::VectorXd y0 = layout.y();
+  const param::PinReport rep = layout.pin({{j, y0[j] + 100}}, {}, 30, 1e-4);
+  ASSERT_TRUE(rep.status.is_ok()) << rep.status.to_string();
+  EXPECT_EQ(rep.pinned[0], 0);
+  EXPECT_EQ(rep.blocking[0], 1);
+  EXPECT_GT(rep.iterations, 0) << "it did try";
+  EXPECT_EQ(layout.y(), y0) << "bit for bit";
+  EXPECT_FALSE(layout.is_pinned(j));
+  EXPECT_EQ(layout.n_flipped(), 0);
+  // With the penalty homotopy the attempt's layout is relaxed and kept (see pin()).
+  param::PinSettings far;
+  far.penalty_stages = 8;
+  const param::PinReport held = layout.pin({{j, y0[j] + 100}}, far, 30, 1e-4);
+  ASSERT_TRUE(held.status.is_ok()) << held.status.to_string();
+  EXPECT_EQ(held.pinned[0], 0);
+  EXPECT_FALSE(layout.is_pinned(j));
+  EXPECT_EQ(layout.n_flipped(), 0);
+  // Then a reachable target still pins, and the layout moves.
+  const Eigen::VectorXd y1 = layout.y();
+  const param::PinReport ok = layout.pin({{j, y1[j] + 0.05}}, {}, 5, 1e-4);
+  ASSERT_TRUE(ok.status.is_ok());
+  EXPECT_EQ(ok.pinned[0], 1);
+  EXPECT_EQ(layout.y()[j], y1[j] + 0.05);
+}
+
 TEST(PinnedLayout, LimitingFacesAreAroundAMoveThatFolds) {
   SphereLayout sphere;
   auto& [mesh, cl, layout, ready] = sphere;

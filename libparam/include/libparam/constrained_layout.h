@@ -221,7 +221,8 @@ class PinnedLayout {
 
   // Moves free variables y_j to targets (j, value) flip-free, the other free variables following
   // by Newton steps on energy with the targets' displacement prescribed, then pins the reached
-  // ones and relaxes with relax_iterations Newton iterations.
+  // ones and relaxes with relax_iterations Newton iterations. A call without penalty stages that
+  // pins no target leaves y exactly as it was.
   PinReport pin(const std::vector<std::pair<int, double>>& targets, const PinSettings& settings,
                 int relax_iterations, double relax_tolerance);
 
