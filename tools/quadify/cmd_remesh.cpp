@@ -44,6 +44,7 @@ struct RemeshArgs {
   double cone_split_distance = 1;  // × the target quad edge length
   double cone_scale = -1;         // × the target quad edge length, 0 = off, < 0 = auto
   double time_budget = 0;         // seconds for the quantization, 0 = none
+  double count_tolerance = quantize::QuantizeOptions{}.count_tolerance;
   // Detected creases that are all shorter than this many target quad edges (no knife edge among
   // them) are left out: an organic model's stray fragments. 0 = always aligned.
   double min_crease_quads = 8;
@@ -155,6 +156,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   quantize_options.threads = common.threads;
   quantize_options.progress = on_progress;
   quantize_options.time_budget_seconds = args.time_budget;
+  quantize_options.count_tolerance = args.count_tolerance;
 
   param::ParamOptions param_options = args.param;
   param_options.cone_pair_distance =
@@ -280,6 +282,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         {"integer_dofs", qs.n_integer_dofs},
         {"reverted", qs.n_reverted},
         {"scale_retries", qs.n_scale_retries},
+        {"count_corrections", qs.n_count_corrections},
+        {"count_corrections_kept", qs.n_count_corrections_kept},
         {"flipped", qs.n_flipped},
         {"cones", qs.n_cones},
         {"aligned_features", qs.n_aligned_features},
@@ -765,6 +769,13 @@ CommandRunner register_remesh(CLI::App& app) {
                  "many quad edges and none is a knife edge (median dihedral angle of at least 120 "
                  "degrees): the stray sharp fragments of an organic model (an ear's rim, a claw), too "
                  "short to shape the quads, which would add cones and distortion (0 = always align)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--count-tolerance", args->count_tolerance,
+                 "With --target-faces: while the quad count is further than this fraction from the target, "
+                 "the integer rounding is run again at a scale corrected by the measured growth (at most "
+                 "twice, each about as long as the first) and the count closest to the target is kept "
+                 "(1 = never: faster, a few percent more quads than asked)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--time-budget", args->time_budget,

@@ -53,6 +53,15 @@ struct QuantizeOptions {
   // releases in one run the next attempt starts (features rounded last, then none). 0: any dead
   // end drops to the next attempt.
   int feature_release_rounds = 32;
+  // Count correction (target_faces > 0 only): the re-optimizations change the map's area (the
+  // quad count) by a few percent, differently from mesh to mesh and scale to scale (±2% at 5,000
+  // quads). While the count is further than count_tolerance × target from the target, the
+  // rounding is run again at a scale corrected by the growth measured, up to
+  // max_count_corrections times (each costs about what the first rounding did), and the map
+  // closest to the target is kept (a run that dead-ends, or keeps fewer feature lines, changes
+  // nothing). Below 1.5% a new rounding is about as likely to land further away as closer.
+  double count_tolerance = 0.015;
+  int max_count_corrections = 2;
   // When the rounding with the aligned features dead-ends: true, quantize the same map without
   // them (at every scale); false, stop there with status kNotConverged and stats.features_dropped
   // set, for a caller that parametrizes again without the features (the map they shaped has
@@ -98,6 +107,8 @@ struct QuantizeOptions {
 struct QuantizeStats {
   double scale = 0;         // final factor from the input UVs to the integer map's UVs
   int n_scale_retries = 0;  // restarts at another scale (near ones first, then refinements)
+  int n_count_corrections = 0;       // roundings run again for the count (count_tolerance)
+  int n_count_corrections_kept = 0;  // of those, closer to the target than the map before
   int n_candidates = 0;     // integer quantities: cone-copy coordinates, seam translations and
                             // the constant coordinates of aligned feature ends
   int n_integer_dofs = 0;   // of those, independent ones (after exact elimination)
