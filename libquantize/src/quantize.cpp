@@ -110,7 +110,8 @@ constexpr int kReleaseRings[] = {0, 1, 2, 4, 8};
 // flip-free energy resists compression more than stretching, so the integer constraints push the
 // map outwards. Measured without allowing for it: +2.7% at 5,000 quads (20 bench meshes, −1.6%
 // to +6.8%), +1.4% at 20,000 (7 meshes), +1.5% at 1,000 (11 meshes, ±5%). The scale allows for
-// it (the quad count is centred on the target) and the count correction starts from it.
+// it with a count correction (QuantizeOptions::count_tolerance > 0: the quad count is centred on
+// the target), which starts from it.
 constexpr double kExpectedGrowth = 0.02;
 // Relative Newton tolerance of the intermediate and final re-optimizations.
 constexpr double kBatchTolerance = 1e-4;
@@ -846,7 +847,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   } else {
     scale = std::sqrt(default_target_faces(mesh) / area_uv);
   }
-  scale /= std::sqrt(1 + kExpectedGrowth);
+  if (options.target_faces > 0 && options.count_tolerance > 0) scale /= std::sqrt(1 + kExpectedGrowth);
   if (!(scale > 0) || !std::isfinite(scale)) {
     out.status =
         core::Status::invalid_input("cannot scale a map of UV area " + std::to_string(area_uv));
@@ -1089,13 +1090,13 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   // Count correction: the re-optimizations grow the map (rounded translations add area) by a
   // few percent beyond what the scale asks for (kExpectedGrowth on average, the scale above
-  // allows for it), by an amount that differs from mesh to mesh and from scale to scale (±2% at
+  // allows for it with count_tolerance > 0), by an amount that differs from mesh to mesh and from scale to scale (±2% at
   // 5,000 quads). While the count is off by more than count_tolerance, the rounding is run again
   // at the scale that expects the growth halfway between the one measured and the average one,
   // without releasing features, and the map closest to the target is kept; a run that
   // dead-ends, flips or keeps fewer feature lines leaves the map as it is (the next one tries a
   // grid finer by half a near_scale_step).
-  if (best && options.target_faces > 0) {
+  if (best && options.target_faces > 0 && options.count_tolerance > 0) {
     const double target = options.target_faces;
     double best_area = uv_area(cl, *best, nf);
     double last_growth = best_area / (st.scale * st.scale * area_uv) - 1;

@@ -772,10 +772,11 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--count-tolerance", args->count_tolerance,
-                 "With --target-faces: while the quad count is further than this fraction from the target, "
-                 "the integer rounding is run again at a scale corrected by the measured growth (at most "
-                 "twice, each about as long as the first) and the count closest to the target is kept "
-                 "(1 = never: faster, a few percent more quads than asked)")
+                 "With --target-faces: aim the count at the target (the rounding grows the map by 2-3% on "
+                 "average) and, while it is further than this fraction from the target, run the integer "
+                 "rounding again at a scale corrected by the growth measured (at most twice, each about as "
+                 "long as the first), keeping the count closest to the target; 0.015 suits (mean error "
+                 "2.9% -> 1.0% at 5,000 quads). 0 = off: a few percent more quads than asked, one rounding")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--time-budget", args->time_budget,
