@@ -981,19 +981,24 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     }
   if (feature_rows.empty() || options.quantize_without_features)
     for (const double sc : scales) attempts.push_back({sc, false, false});
+  // The layout options of a run at `scale` (with or without the kept feature rows) and its start:
+  // the scaled copies, each component translated so that its gauge copy is at the origin.
+  auto start_at = [&](double at_scale, bool with_features) {
+    lopt.extra_rows = with_features ? kept_rows : std::vector<param::AffineRow>{};
+    lopt.prefer_free_coords = with_features ? feature_coords : std::vector<char>{};
+    lopt.rest_scale = at_scale * std::sqrt(area_uv / area3d);
+    Eigen::VectorXd x(n_copy_vars);
+    for (int k = 0; k < cl.n_copies(); ++k)
+      x.segment<2>(2 * k) =
+          at_scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
+    return x;
+  };
   for (int attempt = 0; attempt < static_cast<int>(attempts.size()); ++attempt) {
     st.n_scale_retries = attempt;
     scale = attempts[attempt].scale;
     const bool with_features = attempts[attempt].with_features;
-    lopt.extra_rows = with_features ? kept_rows : std::vector<param::AffineRow>{};
-    lopt.prefer_free_coords = with_features ? feature_coords : std::vector<char>{};
     const std::vector<Candidate>& attempt_candidates = with_features ? candidates : base_candidates;
-    // Scaled copies, each component translated so that its gauge copy is at the origin.
-    Eigen::VectorXd x(n_copy_vars);
-    for (int k = 0; k < cl.n_copies(); ++k)
-      x.segment<2>(2 * k) =
-          scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
-    lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
+    const Eigen::VectorXd x = start_at(scale, with_features);
     char label[48];
     std::snprintf(label, sizeof label, "x%.3f%s", scale / scales[0],
                   with_features ? (attempts[attempt].features_last ? " features-last" : "")
@@ -1110,13 +1115,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
                               : std::sqrt(target / ((1 + 0.5 * (last_growth + kExpectedGrowth)) * area_uv));
       stuck_scale = 0;
       ++st.n_count_corrections;
-      lopt.extra_rows = first.with_features ? kept_rows : std::vector<param::AffineRow>{};
-      lopt.prefer_free_coords = first.with_features ? feature_coords : std::vector<char>{};
-      Eigen::VectorXd x(n_copy_vars);
-      for (int k = 0; k < cl.n_copies(); ++k)
-        x.segment<2>(2 * k) =
-            scale * (cl.x.segment<2>(2 * k) - cl.x.segment<2>(2 * gauge[cl.copy_component[k]]));
-      lopt.rest_scale = scale * std::sqrt(area_uv / area3d);
+      const Eigen::VectorXd x = start_at(scale, first.with_features);
       char label[48];
       std::snprintf(label, sizeof label, "x%.3f count", scale / scales[0]);
       Rounder rounder(mesh, cl, attempt_candidates, is_cone_copy, options, &st,
