@@ -318,9 +318,6 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   EXPECT_LT(j["hausdorff_sym"].get<double>(), 0.02);
 }
 
-// At 800 quads spot's map has 44 cones (36 more than a sphere needs, one per 22 quads): by default
-// the matchings are rounded on a smoothed copy, which leaves fewer cones and still a valid mesh;
-// --cone-scale 0 keeps the paper's map.
 // --count-tolerance: spot at 500 quads comes out with 526 without it (the rounding grows the
 // map), near 500 with it; the report counts the roundings run again.
 TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
@@ -334,6 +331,9 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
   EXPECT_LE(on["quantize"]["count_corrections_kept"].get<int>(), on["quantize"]["count_corrections"].get<int>());
 }
 
+// At 800 quads spot's map has 44 cones (36 more than a sphere needs, one per 22 quads): by default
+// the matchings are rounded on a smoothed copy, which leaves fewer cones and still a valid mesh;
+// --cone-scale 0 keeps the paper's map.
 TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
   const std::string spot = data_path("spot.obj").string();
   auto run = [&](const std::string& extra) {
@@ -664,10 +664,7 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
 // 8 quad edges around at 300 quads; by default the remesher gives them about 12, and
 // --no-feature-sizing keeps the size uniform.
 TEST_F(CliTest, RemeshGivesShortFeatureLoopsMoreQuads) {
-  // The uniform map has no reason to follow the axis: around the middle its grid winds
-  // helically at most targets (a cylinder's helical grid is as isometric as the straight one),
-  // so only its tip-to-middle size ratio is used.
-  auto remesh = [&](const std::string& extra, bool axis_aligned = true) {
+  auto remesh = [&](const std::string& extra) {
     const fs::path out = dir_ / "q.obj";
     const auto report = remesh_report(data_path("washer.obj"), 300, extra);
     EXPECT_EQ(report["quads"]["non_quads"], 0);
@@ -702,10 +699,7 @@ TEST_F(CliTest, RemeshGivesShortFeatureLoopsMoreQuads) {
 TEST_F(CliTest, CurvatureAlignmentTurnsQuadsOntoPrincipalDirections) {
   const fs::path in = dir_ / "ellipsoid.obj";
   write_ellipsoid(in);
-  // The uniform map has no reason to follow the axis: around the middle its grid winds
-  // helically at most targets (a cylinder's helical grid is as isometric as the straight one),
-  // so only its tip-to-middle size ratio is used.
-  auto remesh = [&](const std::string& extra, bool axis_aligned = true) {
+  auto remesh = [&](const std::string& extra) {
     const auto report = remesh_report(in, 600, extra);
     EXPECT_EQ(report["quads"]["non_quads"], 0);
     EXPECT_EQ(report["quads"]["flipped_quads"], 0);
