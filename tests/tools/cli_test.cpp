@@ -329,6 +329,14 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
   const int before = off["quads"]["faces"].get<int>(), after = on["quads"]["faces"].get<int>();
   EXPECT_LT(std::abs(after - 500), std::abs(before - 500)) << before << " -> " << after << " quads";
   EXPECT_LE(on["quantize"]["count_corrections_kept"].get<int>(), on["quantize"]["count_corrections"].get<int>());
+  // Without a count to aim at (an edge length, or the default density) it is refused, not ignored.
+  std::string args;
+  args.append("'").append(data_path("spot.obj").string()).append("' -o '").append((dir_ / "e.obj").string());
+  args.append("' --edge-length 0.05 --count-tolerance 0.015");
+  const CliRun bad = quadify(args, dir_);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--target-faces"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_ / "e.obj"));
 }
 
 // At 800 quads spot's map has 44 cones (36 more than a sphere needs, one per 22 quads): by default

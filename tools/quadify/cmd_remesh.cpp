@@ -778,6 +778,7 @@ CommandRunner register_remesh(CLI::App& app) {
                  "long as the first), keeping the count closest to the target; 0.015 suits (mean error "
                  "2.9% -> 1.0% at 5,000 quads). 0 = off: a few percent more quads than asked, one rounding")
       ->check(CLI::NonNegativeNumber)
+      ->needs(target)
       ->capture_default_str();
   app.add_option("--time-budget", args->time_budget,
                  "Stop the quantization after this many seconds with a message naming the scale and the "
