@@ -1094,13 +1094,13 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     break;
   }
   // Count correction: the re-optimizations grow the map (rounded translations add area) by a
-  // few percent beyond what the scale asks for (kExpectedGrowth on average, the scale above
-  // allows for it with count_tolerance > 0), by an amount that differs from mesh to mesh and from scale to scale (±2% at
-  // 5,000 quads). While the count is off by more than count_tolerance, the rounding is run again
-  // at the scale that expects the growth halfway between the one measured and the average one,
-  // without releasing features, and the map closest to the target is kept; a run that
-  // dead-ends, flips or keeps fewer feature lines leaves the map as it is (the next one tries a
-  // grid finer by half a near_scale_step).
+  // few percent beyond what the scale asks for (kExpectedGrowth on average, which the scale above
+  // allows for with count_tolerance > 0), by an amount that differs from mesh to mesh and from
+  // scale to scale (±2% at 5,000 quads). While the count is off by more than count_tolerance, the
+  // rounding is run again at the scale that expects the growth halfway between the one measured
+  // and the average one, without releasing features, and the map closest to the target is kept;
+  // a run that dead-ends, flips or keeps fewer feature lines leaves the map as it is (the next
+  // one tries a grid finer by half a near_scale_step).
   if (best && options.target_faces > 0 && options.count_tolerance > 0) {
     const double target = options.target_faces;
     double best_area = uv_area(cl, *best, nf);

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <numeric>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "quantize_test_util.h"
@@ -582,12 +583,13 @@ std::vector<int> column_of_variable(const param::ConstrainedReduction& red) {
   return col_of;
 }
 
-// The first vertex copy whose u coordinate is a free variable of the layout (-1: none).
-int first_copy_with_free_u(const param::CopyLayout& cl, const param::PinnedLayout& layout) {
+// The first vertex copy whose u coordinate is a free variable of the layout, and that variable's
+// column ({-1, -1}: none).
+std::pair<int, int> first_copy_with_free_u(const param::CopyLayout& cl, const param::PinnedLayout& layout) {
   const std::vector<int> col_of = column_of_variable(layout.reduction());
   for (int k = 0; k < cl.n_copies(); ++k)
-    if (col_of[2 * k] >= 0) return k;
-  return -1;
+    if (col_of[2 * k] >= 0) return {k, col_of[2 * k]};
+  return {-1, -1};
 }
 
 TEST(PinnedLayout, PinsReachableTargetsAndRefusesDegenerateOnes) {
@@ -639,9 +641,8 @@ TEST(PinnedLayout, AnAttemptThatPinsNothingLeavesTheLayoutAsItWas) {
   SphereLayout sphere;
   auto& [mesh, cl, layout, ready] = sphere;
   ASSERT_TRUE(ready);
-  const int copy = first_copy_with_free_u(cl, layout);
+  const auto [copy, j] = first_copy_with_free_u(cl, layout);
   ASSERT_GE(copy, 0);
-  const int j = column_of_variable(layout.reduction())[2 * copy];
   // A hundred units away: the steps move the layout towards it until the faces around the copy
   // stop them, and the target is dropped.
   const Eigen::VectorXd y0 = layout.y();
@@ -674,9 +675,8 @@ TEST(PinnedLayout, LimitingFacesAreAroundAMoveThatFolds) {
   auto& [mesh, cl, layout, ready] = sphere;
   ASSERT_TRUE(ready);
   // A copy whose u is a free variable; the faces around its vertex.
-  const int copy = first_copy_with_free_u(cl, layout);
+  const auto [copy, j] = first_copy_with_free_u(cl, layout);
   ASSERT_GE(copy, 0);
-  const int j = column_of_variable(layout.reduction())[2 * copy];
   const Eigen::VectorXd y0 = layout.y();
   // A hundredth of a unit: nothing limits it. A hundred units: the faces around the copy (and
   // no others, since the rest follows smoothly) fold first.

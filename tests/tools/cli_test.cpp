@@ -328,7 +328,8 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
   EXPECT_EQ(on["quads"]["flipped_quads"], 0);
   const int before = off["quads"]["faces"].get<int>(), after = on["quads"]["faces"].get<int>();
   EXPECT_LT(std::abs(after - 500), std::abs(before - 500)) << before << " -> " << after << " quads";
-  EXPECT_LE(on["quantize"]["count_corrections_kept"].get<int>(), on["quantize"]["count_corrections"].get<int>());
+  EXPECT_LE(on["quantize"]["count_corrections_kept"].get<int>(),
+            on["quantize"]["count_corrections"].get<int>());
   // Without a count to aim at (an edge length, or the default density) it is refused, not ignored.
   std::string args;
   args.append("'").append(data_path("spot.obj").string()).append("' -o '").append((dir_ / "e.obj").string());
