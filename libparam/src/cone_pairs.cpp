@@ -4,6 +4,7 @@
 #include <limits>
 #include <cmath>
 #include <numbers>
+#include <queue>
 #include <tuple>
 
 namespace quadify::param {
@@ -133,6 +134,105 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
     used_vertex[c.positive_vertex] = used_vertex[c.negative_vertex] = 1;
     for (const SeamChange& ch : c.changes) used_seam[ch.seam] = 1;
     result.push_back(c);
+  }
+  return result;
+}
+
+std::vector<ConePairCancellation> find_surface_cone_pairs(const core::TriMesh& mesh,
+                                                          const CutMesh& cut,
+                                                          const std::vector<int>& index,
+                                                          double max_length,
+                                                          const std::vector<char>& avoid) {
+  std::vector<ConePairCancellation> result;
+  if (!(max_length > 0)) return result;
+  const int nv = mesh.n_vertices();
+  const std::vector<char> excluded = excluded_vertices(mesh, cut, avoid);
+  const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
+  // Surface neighbours (every edge of the mesh) for the pairs' distances.
+  std::vector<std::vector<std::pair<int, double>>> neighbours(nv);
+  for (int e = 0; e < cut.topo.n_edges(); ++e) {
+    const int a = cut.topo.edge_vertex(e, 0), b = cut.topo.edge_vertex(e, 1);
+    const double l = (mesh.V.row(a) - mesh.V.row(b)).norm();
+    neighbours[a].push_back({b, l});
+    neighbours[b].push_back({a, l});
+  }
+  struct Candidate {
+    double distance;
+    int positive, negative;
+  };
+  std::vector<Candidate> candidates;
+  std::vector<double> dist(nv, std::numeric_limits<double>::infinity());
+  std::vector<int> touched;
+  using Item = std::pair<double, int>;
+  for (int p = 0; p < nv; ++p) {
+    if (index[p] <= 0 || excluded[p]) continue;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    dist[p] = 0;
+    touched.push_back(p);
+    queue.push({0.0, p});
+    while (!queue.empty()) {
+      const auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (v != p && index[v] < 0) candidates.push_back({d, p, v});
+      for (const auto& [w, l] : neighbours[v]) {
+        if (excluded[w] || d + l > max_length || !(d + l < dist[w])) continue;
+        if (dist[w] == std::numeric_limits<double>::infinity()) touched.push_back(w);
+        dist[w] = d + l;
+        queue.push({dist[w], w});
+      }
+    }
+    for (const int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    touched.clear();
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return std::tie(a.distance, a.positive, a.negative) <
+           std::tie(b.distance, b.positive, b.negative);
+  });
+  // The seam path of a chosen pair: the shortest along the seams (any length; its matching
+  // changes give the same map as a cut along the surface path would, up to the rotation of the
+  // charts between the two paths, when the two paths bound a region: on a surface of genus > 0
+  // they may also go round a handle, which the caller's checks of the new map then judge).
+  std::vector<int> from_vertex(nv, -1);  // the vertex before v on the seam path
+  std::vector<int> from_step(nv, -1);    // and the entry of its seam adjacency that reaches v
+  std::vector<char> used_vertex(nv, 0);
+  for (const Candidate& c : candidates) {
+    if (used_vertex[c.positive] || used_vertex[c.negative]) continue;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    dist[c.positive] = 0;
+    touched.push_back(c.positive);
+    queue.push({0.0, c.positive});
+    bool reached = false;
+    while (!queue.empty()) {
+      const auto [d, v] = queue.top();
+      queue.pop();
+      if (d > dist[v]) continue;
+      if (v == c.negative) {
+        reached = true;
+        break;
+      }
+      for (int slot = 0; slot < static_cast<int>(adjacency[v].size()); ++slot) {
+        const SeamStep& st = adjacency[v][slot];
+        if (excluded[st.to] || !(d + st.length < dist[st.to])) continue;
+        if (dist[st.to] == std::numeric_limits<double>::infinity()) touched.push_back(st.to);
+        dist[st.to] = d + st.length;
+        from_vertex[st.to] = v;
+        from_step[st.to] = slot;
+        queue.push({dist[st.to], st.to});
+      }
+    }
+    ConePairCancellation pair{c.positive, c.negative, c.distance, {}};
+    if (reached)
+      for (int v = c.negative; v != c.positive; v = from_vertex[v]) {
+        const SeamStep& st = adjacency[from_vertex[v]][from_step[v]];
+        pair.changes.push_back({st.seam, st.orientation});
+      }
+    for (const int v : touched) dist[v] = std::numeric_limits<double>::infinity();
+    touched.clear();
+    if (!reached) continue;
+    std::reverse(pair.changes.begin(), pair.changes.end());
+    used_vertex[c.positive] = used_vertex[c.negative] = 1;
+    result.push_back(std::move(pair));
   }
   return result;
 }

@@ -52,6 +52,21 @@ std::vector<ConePairCancellation> find_cone_pair_cancellations(const core::TriMe
                                                                double max_length, int max_hops,
                                                                const std::vector<char>& avoid = {});
 
+// Disjoint pairs of interior cones of opposite sign whose shortest path over the mesh's edges
+// (avoiding `avoid` and the boundary) is at most max_length, greedily by that length (ties by
+// vertex ids); each with the changes along its shortest path over the seams, of any length. The
+// seam path and the surface path bound a region of charts: changing the matchings along the seam
+// path gives the map a cut along the surface path would give, up to a rotation of those charts,
+// so the pair is as near as the surface says however far the cut's tree takes its seams (a
+// dual-spanning-tree cut joins neighbouring vertices by seam paths 2-9 times longer: knot1).
+// Inner vertices of the seam path may be cones (their index is unchanged); paths may share seams
+// (their changes add up). path_length is the surface length.
+std::vector<ConePairCancellation> find_surface_cone_pairs(const core::TriMesh& mesh,
+                                                          const CutMesh& cut,
+                                                          const std::vector<int>& index,
+                                                          double max_length,
+                                                          const std::vector<char>& avoid = {});
+
 // Splits of cones of index above max_index (a quad vertex of valence 4 − index: index 2 gives a
 // flat corner, index 3 a valence-1 vertex, which no quad mesh has; the rounding makes them at the
 // tips of thin parts) and, with max_index 1, moves of +1 cones crowded by another positive cone

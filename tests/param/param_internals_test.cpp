@@ -83,6 +83,41 @@ TEST(ConePairs, PathsAvoidFlaggedVertices) {
   }
 }
 
+// Pairs by surface distance: a +1 and a −1 cone at the ends of an edge of the dual tree (not a
+// seam; the seams join them by a longer path) pair up when the edge is within the distance; the
+// changes run along the seams and move exactly one unit of index from the +1 to the −1 cone
+// (inner vertices unchanged). Too far, or one end avoided: no pair.
+TEST(ConePairs, SurfacePairsTakeTheSeamPathOfANearPair) {
+  const core::TriMesh m = test::make_icosphere(3);
+  const CutMesh cut = cut_along_dual_tree(m, 0);
+  std::vector<char> seam_edge(cut.topo.n_edges(), 0);
+  for (const CutSeam& s : cut.seams) seam_edge[s.edge] = 1;
+  int e = 0;
+  while (seam_edge[e]) ++e;
+  const int a = cut.topo.edge_vertex(e, 0), b = cut.topo.edge_vertex(e, 1);
+  const double length = (m.V.row(a) - m.V.row(b)).norm();
+  std::vector<int> index(m.n_vertices(), 0);
+  index[a] = 1;
+  index[b] = -1;
+  const std::vector<ConePairCancellation> found = find_surface_cone_pairs(m, cut, index, 1.01 * length);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].positive_vertex, a);
+  EXPECT_EQ(found[0].negative_vertex, b);
+  EXPECT_DOUBLE_EQ(found[0].path_length, length);
+  EXPECT_GE(found[0].changes.size(), 2u) << "a dual-tree edge is no seam: the seam path is longer";
+  std::vector<int> moved(m.n_vertices(), 0);
+  for (const SeamChange& ch : found[0].changes) {
+    const int g = cut.seams[ch.seam].he_a / 3, j = cut.seams[ch.seam].he_a % 3;
+    moved[m.F(g, j)] -= ch.delta;
+    moved[m.F(g, (j + 1) % 3)] += ch.delta;
+  }
+  for (int v = 0; v < m.n_vertices(); ++v) EXPECT_EQ(moved[v], v == a ? -1 : v == b ? 1 : 0) << v;
+  EXPECT_TRUE(find_surface_cone_pairs(m, cut, index, 0.99 * length).empty());
+  std::vector<char> avoid(m.n_vertices(), 0);
+  avoid[b] = 1;
+  EXPECT_TRUE(find_surface_cone_pairs(m, cut, index, 10, avoid).empty());
+}
+
 // Splits: a cone of index 3 gives one unit per call to a regular vertex about `distance` away
 // along the seams; two +1 cones closer than distance/2 are crowded and the one with the larger
 // id moves; every target is regular, at least distance/2 from every other positive cone, and

@@ -212,6 +212,27 @@ TEST(SeamlessParam, ConePairCancellationRemovesClosePairs) {
   }
 }
 
+// Pairs near over the surface (cone_pair_surface): after the seam-path cancellation the map is
+// still flip-free and seamless with Σ index 4χ; every pair removed over the surface removes two
+// cones, and none is left that the seam-path cancellation alone would have removed.
+TEST(SeamlessParam, SurfaceConePairsKeepTheMapValid) {
+  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("spot.obj")));
+  ParamOptions seams;
+  seams.cone_pair_distance = 0.3;  // model units: spot's mean edge length is about 0.04
+  seams.cone_pair_max_hops = 6;
+  const ParamResult before = compute_seamless_param(mesh, seams);
+  check_result("spot (seam pairs)", mesh, before);
+  ParamOptions surface = seams;
+  surface.cone_pair_surface = true;
+  const ParamResult after = compute_seamless_param(mesh, surface);
+  const Checked c = check_result("spot (surface pairs)", mesh, after);
+  EXPECT_EQ(c.cone_sum, 8) << "Σ cone index must stay 4χ";
+  EXPECT_EQ(before.stats.n_surface_pairs, 0);
+  EXPECT_GT(after.stats.n_surface_pairs, 0);
+  EXPECT_EQ(after.stats.n_cancelled_pairs - after.stats.n_surface_pairs, before.stats.n_cancelled_pairs);
+  EXPECT_EQ(after.stats.n_cones, before.stats.n_cones - 2 * after.stats.n_surface_pairs);
+}
+
 // Cone splitting: the thin spike's apex gets a cone of index 3 (UV angle π/2, a quad vertex of
 // valence 1); with cone_split_distance no cone keeps an index above cone_split_max_index, the
 // map stays flip-free and seamless, Σ index stays 4χ, and the units moved off the apex are new

@@ -95,6 +95,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"patches", s.n_patches},
                      {"improved", s.n_improved},
                      {"cancelled_pairs", s.n_cancelled_pairs},
+                     {"surface_pairs", s.n_surface_pairs},
                      {"split_cones", s.n_split_cones},
                      {"deferred_matchings", s.n_deferred_matchings},
                      {"coarse_cones", s.coarse_cones},
@@ -185,6 +186,9 @@ CommandRunner register_param(CLI::App& app) {
   app.add_option("--cone-pair-hops", o.cone_pair_max_hops, "Seam edges of a cone-pair cancellation path")
       ->check(CLI::Range(1, 10))
       ->capture_default_str();
+  app.add_flag("--surface-cone-pairs", o.cone_pair_surface,
+               "With --cone-pair-distance: then also remove the pairs within that distance over the surface "
+               "whose seam path is longer, along that seam path, where the map's tau grows by at most 5%");
   app.add_option("--cone-split-distance", o.cone_split_distance,
                  "Split every cone of index above --cone-split-max-index (a quad vertex of valence 1 or 2, made "
                  "at the tips of thin parts), moving one unit of index at a time to a vertex about this far "
