@@ -118,6 +118,8 @@ constexpr double kSurfacePairTauGrowth = 1.05;
 // (1.75), 793 (2), 711 (no bound); at 2, screwdriver's Hausdorff passed MIQ+QEx's and
 // spot_nonmanifold's τ rose 1.55 → 1.86.
 constexpr double kSurfacePairSizeChange = 1.75;
+// Failed sets the surface pairs may cost (each a whole-mesh homotopy, 2-3 s on feline).
+constexpr int kSurfacePairFailures = 3;
 // Penalty stages of a cancellation's move into its constraints (w = 1e3 … 1e5): a set that needs
 // more is rarely made flip-free by the rest of the ladder, and each failure costs a whole-mesh
 // homotopy (casting: 6 failures took 31 of the 43 s of its map).
@@ -738,9 +740,17 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       cancel_passes(feature_vertices);
     }
     // Then the pairs near over the surface whose seam path is long (cone_pair_surface), off the
-    // aligned features, kept when the map's τ grows by at most kSurfacePairTauGrowth.
-    if (options.cone_pair_surface) {
-      move_failures = 0;
+    // aligned features, kept when the map's τ grows by at most kSurfacePairTauGrowth. Not on a
+    // map that its caller replaces for its cones anyway (continue_before_tau false: the
+    // remesher's coarse cones; feline: 7 s of whole-mesh solves saved).
+    bool surface_pairs = options.cone_pair_surface;
+    if (surface_pairs && options.energy == Energy::kTau && options.continue_before_tau) {
+      const std::vector<int> index = vertex_indices(mesh, cut, x);
+      surface_pairs = options.continue_before_tau(
+          static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; })));
+    }
+    if (surface_pairs) {
+      move_failures = kMaxCancellationFailures - kSurfacePairFailures;
       max_size_change = kSurfacePairSizeChange;
       for (int pass = 0; pass < kConePairPasses && move_failures < kMaxCancellationFailures; ++pass) {
         std::vector<ConePairCancellation> pairs = find_surface_cone_pairs(

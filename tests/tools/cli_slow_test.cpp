@@ -84,7 +84,7 @@ TEST_F(CliSlow, WingnutKeepsItsShortSharpEdgesAndItsNarrowBands) {
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
   EXPECT_NEAR(report["quads"]["faces"].get<double>(), 5000, 500);
   EXPECT_GE(report["quads"]["feature_capture"].get<double>(), 0.955);
-  const nlohmann::json off_report = remesh("wingnut.obj", "--no-feature-sizing --no-surface-cone-pairs");
+  const nlohmann::json off_report = remesh("wingnut.obj", "--no-feature-sizing --surface-cone-pairs off");
   ASSERT_FALSE(off_report.is_null());
   EXPECT_LT(off_report["quads"]["feature_capture"].get<double>(),
             report["quads"]["feature_capture"].get<double>() - 0.01);

@@ -340,17 +340,16 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
   EXPECT_FALSE(fs::exists(dir_ / "e.obj"));
 }
 
-// At 600 quads spot's map has 26 cones (18 more than a sphere needs, one per 33 quads): by default
+// At 800 quads spot's map has 44 cones (36 more than a sphere needs, one per 22 quads): by default
 // the matchings are rounded on a smoothed copy, which leaves fewer cones and still a valid mesh;
-// --cone-scale 0 keeps the paper's map. (At 800 quads the map had 44 cones before the cone pairs
-// near over the surface were cancelled too; with them it has 26, one per 44 quads, and no
-// smoothed copy is needed.)
+// --cone-scale 0 keeps the paper's map, which then also loses the cone pairs near over the surface
+// (--surface-cone-pairs; the map the smoothed copy replaces skips them): fewer cones than 44.
 TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
   const std::string spot = data_path("spot.obj").string();
   auto run = [&](const std::string& extra) {
     std::string args;
     args.append("'").append(spot).append("' -o '").append((dir_ / "o.obj").string());
-    args.append("' --target-faces 600 --samples 20000 --json '").append((dir_ / "r.json").string());
+    args.append("' --target-faces 800 --samples 20000 --json '").append((dir_ / "r.json").string());
     args.append("' ").append(extra);
     const CliRun r = quadify(args, dir_);
     EXPECT_EQ(r.exit_code, 0) << r.err;
@@ -367,16 +366,25 @@ TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
   EXPECT_EQ(q["flipped_quads"], 0);
   EXPECT_EQ(q["genus"], 0);
   EXPECT_LT(q["irregular_vertices"].get<int>(), fine_cones);
-  EXPECT_NEAR(q["faces"].get<int>(), 600, 60);
+  EXPECT_NEAR(q["faces"].get<int>(), 800, 80);
   EXPECT_LT(q["hausdorff_sym"].get<double>(), 0.02);
   const auto plain = run("--cone-scale 0");
   EXPECT_EQ(plain["param"]["coarse_cones"], false);
   EXPECT_TRUE(plain["param"]["fine_cones"].is_null());
-  EXPECT_EQ(plain["param"]["cones"], fine_cones);
+  EXPECT_LT(plain["param"]["cones"].get<int>(), fine_cones);
+  EXPECT_GT(plain["param"]["surface_pairs"].get<int>(), 0);
+  const auto seams_only = run("--cone-scale 0 --surface-cone-pairs off");
+  EXPECT_EQ(seams_only["param"]["cones"], fine_cones);
+  EXPECT_EQ(seams_only["param"]["surface_pairs"], 0);
   std::string bad_args;
   bad_args.append("'").append(spot).append("' -o o.obj --cone-scale sometimes");
   const CliRun bad = quadify(bad_args, dir_);
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  std::string bad_pairs;
+  bad_pairs.append("'").append(spot).append("' -o o.obj --surface-cone-pairs sometimes");
+  const CliRun bad_pairs_run = quadify(bad_pairs, dir_);
+  EXPECT_EQ(bad_pairs_run.exit_code, 2) << bad_pairs_run.err;
+  EXPECT_NE(bad_pairs_run.err.find("--surface-cone-pairs"), std::string::npos) << bad_pairs_run.err;
 }
 
 // A run that fails after the input was read writes no mesh, but its report says what failed and
