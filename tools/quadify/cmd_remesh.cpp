@@ -78,9 +78,9 @@ constexpr double kThinSize = 0.95;
 // or more within this many target quad edges (param::ParamOptions::feature_corner_length).
 constexpr double kFeatureCornerQuadEdges = 2;
 // --surface-cone-pairs auto: on for inputs of at most this many triangles. Each set of pairs costs
-// a whole-mesh solve (2-3 s at 100K triangles), and the map's fewer cones make its rounding
-// longer: feline (100K) took 85 s in all with them instead of 70 s (issue 5 asks 80 s), for 114 →
-// 96 irregular vertices.
+// a whole-mesh solve (2-3 s at 100K triangles) and the map's fewer cones may make its rounding
+// longer: feline (100K), with them on its coarse-cone map at the time, took 85 s in all instead of
+// 70 s (issue 5 asks 80 s), for 114 → 96 irregular vertices.
 constexpr int kSurfacePairMaxFaces = 60'000;
 // A cone that dead-ends at two scales where the surface's radius is below this many quad edges
 // (thin-part size) stops the quantization there: more scales of the same map rarely help there,
