@@ -1,5 +1,7 @@
 #include "cone_pairs.h"
 
+#include <libcore/topology.h>
+
 #include <algorithm>
 #include <limits>
 #include <cmath>
@@ -148,14 +150,7 @@ std::vector<ConePairCancellation> find_surface_cone_pairs(const core::TriMesh& m
   const int nv = mesh.n_vertices();
   const std::vector<char> excluded = excluded_vertices(mesh, cut, avoid);
   const std::vector<std::vector<SeamStep>> adjacency = seam_adjacency(mesh, cut);
-  // Surface neighbours (every edge of the mesh) for the pairs' distances.
-  std::vector<std::vector<std::pair<int, double>>> neighbours(nv);
-  for (int e = 0; e < cut.topo.n_edges(); ++e) {
-    const int a = cut.topo.edge_vertex(e, 0), b = cut.topo.edge_vertex(e, 1);
-    const double l = (mesh.V.row(a) - mesh.V.row(b)).norm();
-    neighbours[a].push_back({b, l});
-    neighbours[b].push_back({a, l});
-  }
+  const std::vector<std::vector<int>> neighbours = core::vertex_neighbours(mesh);
   struct Candidate {
     double distance;
     int positive, negative;
@@ -175,7 +170,8 @@ std::vector<ConePairCancellation> find_surface_cone_pairs(const core::TriMesh& m
       queue.pop();
       if (d > dist[v]) continue;
       if (v != p && index[v] < 0) candidates.push_back({d, p, v});
-      for (const auto& [w, l] : neighbours[v]) {
+      for (const int w : neighbours[v]) {
+        const double l = (mesh.V.row(v) - mesh.V.row(w)).norm();
         if (excluded[w] || d + l > max_length || !(d + l < dist[w])) continue;
         if (dist[w] == std::numeric_limits<double>::infinity()) touched.push_back(w);
         dist[w] = d + l;

@@ -700,6 +700,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     const int first = apply_moves(moves, begin, mid, tau_bound);
     return first + apply_moves(moves, mid, end, tau_bound);
   };
+  // Cones of the current layout (vertices of nonzero index).
+  auto count_cones = [&] {
+    const std::vector<int> index = vertex_indices(mesh, cut, x);
+    return static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; }));
+  };
   // The τ a set of short seam paths may leave: such pairs cannot stay anyway.
   auto short_pair_tau_bound = [&] {
     return std::max(kCancellationTauFloor, kCancellationTauGrowth * max_isometric_distortion(domain, x));
@@ -744,11 +749,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // map that its caller replaces for its cones anyway (continue_before_tau false: the
     // remesher's coarse cones; feline: 7 s of whole-mesh solves saved).
     bool surface_pairs = options.cone_pair_surface;
-    if (surface_pairs && options.energy == Energy::kTau && options.continue_before_tau) {
-      const std::vector<int> index = vertex_indices(mesh, cut, x);
-      surface_pairs = options.continue_before_tau(
-          static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; })));
-    }
+    if (surface_pairs && options.energy == Energy::kTau && options.continue_before_tau)
+      surface_pairs = options.continue_before_tau(count_cones());
     if (surface_pairs) {
       move_failures = kMaxCancellationFailures - kSurfacePairFailures;
       max_size_change = kSurfacePairSizeChange;
@@ -759,7 +761,6 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         // A set that changes some faces' size too much goes again without the pairs nearest to
         // those faces (by their cones), until one is kept or none is left.
         while (!pairs.empty() && move_failures < kMaxCancellationFailures) {
-          oversized_faces.clear();
           n = apply_moves(pairs, 0, pairs.size(), kSurfacePairTauGrowth * max_isometric_distortion(domain, x));
           if (n > 0 || oversized_faces.empty()) break;
           std::vector<char> drop(pairs.size(), 0);
@@ -886,9 +887,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   }
   bool tau_continuation = options.energy == Energy::kTau;
   if (tau_continuation && options.continue_before_tau && out.status.is_ok()) {
-    const std::vector<int> index = vertex_indices(mesh, cut, x);
-    const int n_cones = static_cast<int>(std::count_if(index.begin(), index.end(), [](int i) { return i != 0; }));
-    if (!options.continue_before_tau(n_cones)) {
+    if (!options.continue_before_tau(count_cones())) {
       tau_continuation = false;
       out.stats.stopped_before_tau = true;
     }
