@@ -679,6 +679,49 @@ TEST_F(CliTest, AdaptiveSizingFollowsTheCurvature) {
   EXPECT_EQ(nlohmann::json::parse(slurp(dir_ / "r.json"))["param"]["sizing"]["mode"], "adaptive-anisotropic");
 }
 
+// bench/capture_breakdown.py reads the integer map (--map) and the quads: its capture is the
+// report's (the same sharp edges, samples and tolerance; the washer needs no repair), the length
+// it counts as missed adds up to what the capture leaves, and the washer's rims lie on integer
+// iso-lines. A map without UVs is refused with a message naming the file.
+TEST_F(CliTest, CaptureBreakdownAccountsForTheMissedFeatureLength) {
+  if (quadify::test::exit_code_of(std::system("python3 --version >/dev/null 2>&1")) != 0)
+    GTEST_SKIP() << "python3 not found";
+  const fs::path map = dir_ / "washer_map.obj";
+  const auto report = remesh_report(data_path("washer.obj"), 300, "--map '" + map.string() + "'");
+  ASSERT_TRUE(fs::exists(map));
+  const fs::path script =
+      data_path("washer.obj").parent_path().parent_path().parent_path() / "bench" / "capture_breakdown.py";
+  ASSERT_TRUE(fs::exists(script)) << script;
+  auto run = [&](const fs::path& map_file, const fs::path& json) {
+    std::string cmd = "python3 ";
+    cmd.append(quadify::test::shell_quoted(script)).append(" ").append(quadify::test::shell_quoted(map_file));
+    cmd.append(" ").append(quadify::test::shell_quoted(dir_ / "q.obj")).append(" --json ");
+    cmd.append(quadify::test::shell_quoted(json)).append(" >'").append((dir_ / "b.out").string());
+    cmd.append("' 2>'").append((dir_ / "b.err").string()).append("'");
+    return quadify::test::exit_code_of(std::system(cmd.c_str()));
+  };
+  ASSERT_EQ(run(map, dir_ / "b.json"), 0) << slurp(dir_ / "b.err");
+  const auto b = nlohmann::json::parse(slurp(dir_ / "b.json"));
+  EXPECT_GT(b["sharp_edges"].get<int>(), 0);
+  EXPECT_NEAR(b["capture"].get<double>(), report["quads"]["feature_capture"].get<double>(), 1e-9);
+  double missed = 0, length = 0;
+  for (const auto& [kind, share] : b["missed"].items()) missed += share.get<double>();
+  for (const auto& [kind, share] : b["length"].items()) length += share.get<double>();
+  EXPECT_NEAR(missed, 1 - b["capture"].get<double>(), 1e-9);
+  EXPECT_NEAR(length, 1, 1e-9);
+  EXPECT_GT(b["length"]["aligned"].get<double>(), 0.9) << "the rims on integer iso-lines";
+  // The rims are circles about a dozen quad edges around: what the quads miss of them is mostly
+  // cut off by the chords (a chord of a twelfth of the inner rim misses it by 3.4% of its radius,
+  // above 0.1% of the diagonal).
+  const auto& m = b["missed"];
+  EXPECT_GT(m["chord"].get<double>(), m["unaligned"].get<double>() + m["parallel"].get<double>() +
+                                          m["chain end"].get<double>() + m["other"].get<double>());
+  // The quads as the map: no UVs.
+  EXPECT_EQ(run(dir_ / "q.obj", dir_ / "bad.json"), 1);
+  EXPECT_NE(slurp(dir_ / "b.err").find("q.obj: no per-corner UVs"), std::string::npos) << slurp(dir_ / "b.err");
+  EXPECT_FALSE(fs::exists(dir_ / "bad.json"));
+}
+
 // Feature-loop sizing: the washer's inner rims (circles of radius 0.1, 0.63 long) are about
 // 8 quad edges around at 300 quads; by default the remesher gives them about 12, and
 // --no-feature-sizing keeps the size uniform.
