@@ -7,6 +7,7 @@ memory limit per mesh, and writes one table (Markdown, TSV, JSON) of per-mesh fi
   bench/run_bench.py --mode remesh --target-faces 5000
   bench/run_bench.py --meshes DIR --only spot,knot1 --timeout 300 --mem-gb 8
   bench/run_bench.py --mode remesh --max-faces 0   # also the large meshes (hours)
+  bench/run_bench.py --mode remesh --capture-breakdown  # + the capture's missed length by cause
 
 In param and remesh modes, meshes with more than --max-faces triangles (40,000; from the folder's
 MANIFEST.tsv, or counted in an OBJ) are listed as skipped, not run: over ../shared/meshes that
@@ -28,6 +29,8 @@ import time
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import capture_breakdown  # noqa: E402  (bench/capture_breakdown.py)
 MESH_EXT = {".obj", ".off", ".ply", ".stl", ".gltf", ".glb"}
 
 
@@ -186,6 +189,9 @@ def main():
     ap.add_argument("--mem-gb", type=float, default=12, help="address-space limit per process (GiB)")
     ap.add_argument("--target-faces", type=int, default=5000, help="remesh mode: target quad count")
     ap.add_argument("--extra", default="", help="extra arguments passed to the stage command")
+    ap.add_argument("--capture-breakdown", action="store_true",
+                    help="remesh mode: also write each integer map (outputs/<mesh>_map.obj) and split the "
+                         "feature capture's missed length by cause (bench/capture_breakdown.py)")
     ap.add_argument("--max-faces", type=int, default=40000,
                     help="param/remesh: skip meshes with more triangles than this (0 = run all; "
                          "ignored for meshes named in --only)")
@@ -206,6 +212,12 @@ def main():
     face_counts = manifest_face_counts(meshes_dir)
     extra = args.extra.split() if args.extra else []
 
+    # Feature capture's missed length by cause (shares of the sharp-edge length).
+    breakdown_columns = []
+    if args.capture_breakdown and args.mode == "remesh":
+        breakdown_columns = [("missed unaligned", "unaligned"), ("missed parallel", "parallel"),
+                             ("missed chain end", "chain end"), ("missed chord", "chord"),
+                             ("missed other", "other")]
     rows = []
     for path in files:
         name = path.stem
@@ -232,6 +244,10 @@ def main():
             output = out_dir / "outputs" / (name + "_quad.obj")
             cmd = [str(quadify), str(path), "-o", str(output), "--target-faces", str(args.target_faces),
                    "--json", str(run_json), "-q"] + extra
+            map_output = out_dir / "outputs" / (name + "_map.obj")
+            if args.capture_breakdown:
+                map_output.unlink(missing_ok=True)
+                cmd += ["--map", str(map_output)]
         if output is not None:
             output.unlink(missing_ok=True)
         result = run_limited(cmd, args.timeout, mem)
@@ -249,11 +265,19 @@ def main():
         row = {"mesh": name, **result}
         for header, which, dotted in COLUMNS[args.mode]:
             row[header] = dig(reports[which], dotted)
+        if breakdown_columns and dig(check, "check.feature_capture") not in (None, -1) and map_output.is_file():
+            try:
+                missed = capture_breakdown.breakdown(str(map_output), str(output), 40, 1e-3)["missed"]
+                for header, cause in breakdown_columns:
+                    row[header] = missed[cause]
+            except (OSError, ValueError, IndexError) as e:
+                row["message"] = (row.get("message") or "") + " capture breakdown: %s" % e
         rows.append(row)
         print("%-28s %-10s %7.2fs %7.1f MB %s" % (name, result["status"], result["seconds"], result["peak_mb"],
                                                    result["message"]), file=sys.stderr, flush=True)
 
-    headers = ["mesh", "status", "seconds", "peak_mb"] + [h for h, _, _ in COLUMNS[args.mode]] + ["message"]
+    headers = (["mesh", "status", "seconds", "peak_mb"] + [h for h, _, _ in COLUMNS[args.mode]] +
+               [h for h, _ in breakdown_columns] + ["message"])
     with open(out_dir / "table.tsv", "w") as f:
         f.write("\t".join(headers) + "\n")
         for r in rows:
