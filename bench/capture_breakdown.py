@@ -97,7 +97,14 @@ class SegmentGrid:
         return best
 
 
-def breakdown(map_path, quads_path, angle_deg, tolerance):
+ANGLE_DEG = 40     # sharp above this dihedral angle (quadify check's --feature-angle default)
+TOLERANCE = 1e-3   # captured within this × bbox diagonal (QuadMetricsOptions::feature_capture_tolerance)
+CAUSES = ("unaligned", "parallel", "chain end", "chord", "other")
+
+
+def breakdown(map_path, quads_path, angle_deg=ANGLE_DEG, tolerance=TOLERANCE):
+    """Figures of the map and its quads: sharp_edges, capture (-1 without sharp edges, as quadify
+    check), length (share per kind of sharp edge) and missed (share per cause, CAUSES)."""
     V, T, F = read_obj(map_path, True)
     Q, _, QF = read_obj(quads_path, False)
     if not T or any(t < 0 for _, ts in F for t in ts):
@@ -131,6 +138,8 @@ def breakdown(map_path, quads_path, angle_deg, tolerance):
                 if kind == "aligned":
                     break
         sharp[e] = kind
+    if not sharp:
+        return {"sharp_edges": 0, "capture": -1, "length": {}, "missed": {k: 0.0 for k in CAUSES}}
     quad_edges = set()
     for vs, _ in QF:
         for k in range(len(vs)):
@@ -143,10 +152,12 @@ def breakdown(map_path, quads_path, angle_deg, tolerance):
     grid = SegmentGrid(segments)
     feature_grid = SegmentGrid([(V[a], V[b]) for a, b in sharp])
     on_curve = 1e-6 * diag
+    ends_on_curve = {}  # quad segment -> how many of its ends lie on a sharp edge
 
-    def on_feature(p):
-        d, _ = feature_grid.nearest(p)
-        return d <= on_curve
+    def ends_on_feature(j):
+        if j not in ends_on_curve:
+            ends_on_curve[j] = sum(feature_grid.nearest(q)[0] <= on_curve for q in segments[j])
+        return ends_on_curve[j]
 
     spacing = 1e-3 * diag
     length = defaultdict(float)
@@ -166,15 +177,14 @@ def breakdown(map_path, quads_path, angle_deg, tolerance):
                 continue
             cause = kind
             if kind == "aligned":
-                ends = sum(on_feature(q) for q in segments[j]) if j >= 0 else 0
-                cause = ("other", "chain end", "chord")[ends]
+                cause = ("other", "chain end", "chord")[ends_on_feature(j) if j >= 0 else 0]
             missed[cause] += edge_length / n
     share = lambda x: x / total if total > 0 else 0.0
     return {
         "sharp_edges": len(sharp),
         "capture": 1 - share(sum(missed.values())),
         "length": {k: share(v) for k, v in length.items()},
-        "missed": {k: share(missed.get(k, 0.0)) for k in ("unaligned", "parallel", "chain end", "chord", "other")},
+        "missed": {k: share(missed.get(k, 0.0)) for k in CAUSES},
     }
 
 
@@ -182,8 +192,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("map", help="the integer-seamless map (quadify --map MAP.obj)")
     parser.add_argument("quads", help="the quad mesh extracted from it")
-    parser.add_argument("--angle", type=float, default=40, help="sharp above this dihedral angle (degrees)")
-    parser.add_argument("--tolerance", type=float, default=1e-3, help="captured within this × bbox diagonal")
+    parser.add_argument("--angle", type=float, default=ANGLE_DEG, help="sharp above this dihedral angle (degrees)")
+    parser.add_argument("--tolerance", type=float, default=TOLERANCE, help="captured within this × bbox diagonal")
     parser.add_argument("--name", default=None, help="row name (default: the quads file's stem)")
     parser.add_argument("--header", action="store_true", help="print the Markdown table's header first")
     parser.add_argument("--json", default=None, help="also write the figures to this JSON file")

@@ -267,7 +267,7 @@ def main():
             row[header] = dig(reports[which], dotted)
         if breakdown_columns and dig(check, "check.feature_capture") not in (None, -1) and map_output.is_file():
             try:
-                missed = capture_breakdown.breakdown(str(map_output), str(output), 40, 1e-3)["missed"]
+                missed = capture_breakdown.breakdown(str(map_output), str(output))["missed"]
                 for header, cause in breakdown_columns:
                     row[header] = missed[cause]
             except (OSError, ValueError, IndexError) as e:
