@@ -297,6 +297,43 @@ TEST(QuantizeSeamless, EdgeLengthSetsTheScale) {
   EXPECT_EQ(q.stats.n_count_corrections, 0) << "an edge length asks for no count";
 }
 
+// Without a target count or an edge length: at least 5,000 quads (a triangulated CAD part has few
+// triangles for its features), one per six triangles above 30,000 triangles.
+TEST(QuantizeSeamless, DefaultDensityIsAtLeastFiveThousandQuads) {
+  auto area_of = [](const core::TriMesh& m) {
+    double a = 0;
+    for (int f = 0; f < m.n_faces(); ++f) {
+      const Eigen::Vector3d p0 = m.V.row(m.F(f, 0)), p1 = m.V.row(m.F(f, 1)), p2 = m.V.row(m.F(f, 2));
+      a += 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    }
+    return a;
+  };
+  const core::TriMesh box = load("box.obj");
+  const quantize::QuantizeOptions defaults;
+  EXPECT_NEAR(quantize::target_edge_length(box, defaults), std::sqrt(area_of(box) / 5000), 1e-12);
+  // A flat 120 × 130 grid of 31,200 triangles: 5,200 quads.
+  core::TriMesh grid;
+  const int nx = 120, ny = 130;
+  grid.V.resize((nx + 1) * (ny + 1), 3);
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) grid.V.row(j * (nx + 1) + i) << 0.01 * i, 0.01 * j, 0;
+  grid.F.resize(2 * nx * ny, 3);
+  for (int j = 0, f = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int v = j * (nx + 1) + i;
+      grid.F.row(f++) << v, v + 1, v + nx + 2;
+      grid.F.row(f++) << v, v + nx + 2, v + nx + 1;
+    }
+  EXPECT_NEAR(quantize::target_edge_length(grid, defaults), std::sqrt(area_of(grid) / 5200), 1e-12);
+  // The box quantized at the default density: about 5,000 quads.
+  const param::ParamResult p = param::compute_seamless_param(box);
+  ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
+  const quantize::QuantizeResult q = quantize::quantize_seamless(box, p, defaults);
+  ASSERT_TRUE(q.status.is_ok()) << q.status.to_string();
+  EXPECT_NEAR(q.stats.uv_area, 5000, kQuadCountTolerance * 5000);
+  EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
+}
+
 // The re-optimizations grow the map by a few percent, differently from mesh to mesh and scale to
 // scale; the count correction runs the rounding again at a corrected scale while the count is
 // off by more than count_tolerance and keeps the map closest to the target. Without a target

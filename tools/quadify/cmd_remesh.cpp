@@ -286,7 +286,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     const quantize::QuantizeStats& qs = map.stats;
     return nlohmann::json{
         {"scale", qs.scale},
-        {"target_faces", args.target_faces},
+        {"target_faces", args.target_faces},  // 0: the default density (see --target-faces)
+        {"target_edge_length", quad_edge},    // the quad edge length asked for, in model units
         {"uv_area", qs.uv_area},
         {"integer_dofs", qs.n_integer_dofs},
         {"reverted", qs.n_reverted},
@@ -725,7 +726,7 @@ CommandRunner register_remesh(CLI::App& app) {
       ->required()
       ->type_name("OUT");
   auto* target = app.add_option("--target-faces", args->target_faces,
-                                "Number of quads wanted (default: max(100, #triangles/6)); usually met "
+                                "Number of quads wanted (default: max(5000, #triangles/6)); usually met "
                                 "within a few percent, exceeded where a handle is thinner than about a "
                                 "quad (the grid is refined by 1.3x until every handle keeps its quads)")
                      ->check(CLI::Range(1, 100'000'000))

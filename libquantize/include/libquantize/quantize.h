@@ -27,7 +27,8 @@ struct DeadEnd {
 struct QuantizeOptions {
   // Number of quads wanted: each unit square of the scaled map is one quad, so the map is scaled
   // to a UV area of target_faces. 0: use edge_length; if both are 0 the default target is
-  // max(100, #F / 6) quads (about one quad per three triangle pairs).
+  // max(5000, #F / 6) quads (about one quad per three triangle pairs, and at least 5,000: a
+  // triangulated CAD part has few triangles for its features; see kMinDefaultQuads).
   int target_faces = 0;
   // Quad edge length in model units (used when target_faces = 0): the map, near-isometric up to
   // a global factor, is scaled so that one UV unit ≈ edge_length on the surface.
