@@ -316,6 +316,32 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   EXPECT_NEAR(j["faces"].get<int>(), 1500, 150) << "face count within 10% of the target";
   // About 1% of the diagonal at this coarse density (0.66% at 5,000 quads).
   EXPECT_LT(j["hausdorff_sym"].get<double>(), 0.02);
+  // The summary line; spot's few creases are too short to align (stray), so no feature capture.
+  EXPECT_NE(r.out.find(" -> "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("feature capture"), std::string::npos) << r.out;
+}
+
+// The summary names the feature capture where features were aligned, and a result farther from
+// the input than 1% of its diagonal gets a warning that says what helps (the washer at 150 quads:
+// about 1.5%); --quiet prints neither.
+TEST_F(CliTest, RemeshSummaryGivesTheCaptureAndWarnsWhenCoarse) {
+  const std::string washer = data_path("washer.obj").string();
+  std::string args;
+  args.append("'").append(washer).append("' -o '").append((dir_ / "w.obj").string());
+  args.append("' --target-faces 150 --json '").append((dir_ / "w.json").string()).append("'");
+  const CliRun r = quadify(args, dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto quads = nlohmann::json::parse(slurp(dir_ / "w.json"))["quads"];
+  const double hausdorff = quads["hausdorff_sym"].get<double>();
+  EXPECT_GT(hausdorff, 0.01) << "the test needs a coarse result";
+  EXPECT_NE(r.err.find("washer.obj: the quads leave the input by up to"), std::string::npos) << r.err;
+  char capture[64];
+  std::snprintf(capture, sizeof capture, "feature capture %.3f", quads["feature_capture"].get<double>());
+  EXPECT_NE(r.out.find(capture), std::string::npos) << r.out;
+  const CliRun quiet = quadify(args + " --quiet", dir_);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("leave the input"), std::string::npos) << quiet.err;
+  EXPECT_EQ(quiet.out, "");
 }
 
 // --count-tolerance: spot at 500 quads comes out with 526 without it (the rounding grows the
