@@ -303,6 +303,11 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
   EXPECT_EQ(report["command"], "remesh");
   EXPECT_EQ(report["quantize"]["flipped"], 0);
+  // Where the parametrization's time went, as `quadify param` reports it.
+  const auto& profile = report["param"]["profile"];
+  EXPECT_GT(profile["seconds_factorize"].get<double>(), 0);
+  EXPECT_LE(profile["seconds_factorize"].get<double>(), report["param"]["seconds"].get<double>());
+  EXPECT_GT(profile["transition_iterations"].get<int>() + profile["tau_iterations"].get<int>(), 0);
   const CliRun c = quadify("check '" + out.string() + "' --reference '" + spot + "' --json '" +
                                (dir_ / "c.json").string() + "'",
                            dir_);

@@ -282,7 +282,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         {"features", feature_json(feature_input, ps)},
         {"sizing", sizing.report},
         {"curvature_alignment", direction_json(sizing, ps)},
-        {"seconds", ps.seconds_total}};
+        {"seconds", ps.seconds_total},
+        {"profile", param_profile_json(ps)}};
   };
   auto quantize_json = [&](const quantize::QuantizeResult& map) {
     const quantize::QuantizeStats& qs = map.stats;

@@ -250,6 +250,26 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
   return fi;
 }
 
+nlohmann::json param_profile_json(const param::ParamStats& s) {
+  return {{"seconds_cut", s.seconds_cut},
+          {"seconds_optimize", s.seconds_optimize},
+          {"seconds_local_estimation", s.seconds_local_estimation},
+          {"seconds_elimination", s.seconds_elimination},
+          {"seconds_setup", s.seconds_setup},
+          {"seconds_assembly", s.seconds_assembly},
+          {"seconds_analyze", s.seconds_analyze},
+          {"seconds_factorize", s.seconds_factorize},
+          {"seconds_line_search", s.seconds_line_search},
+          {"seconds_projection", s.seconds_projection},
+          {"seconds_tau", s.seconds_tau},
+          {"transition_iterations", s.n_transition_iterations},
+          {"batch_iterations", s.n_batch_iterations},
+          {"tau_iterations", s.n_tau_iterations},
+          {"max_hessian_nonzeros", s.max_hessian_nonzeros},
+          {"max_element_variables", s.max_element_variables},
+          {"max_sum_sq_element_variables", s.max_sum_sq_element_variables}};
+}
+
 nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) {
   return {{"mode", fi.soft ? "after" : "during"},
           {"curve_labels", fi.curve_labels},

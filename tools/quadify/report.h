@@ -118,6 +118,10 @@ FeatureInput apply_feature_args(const FeatureArgs& args, const std::string& inpu
                                 LoadedMesh* loaded, param::ParamOptions* options);
 nlohmann::json feature_json(const FeatureInput& input, const param::ParamStats& stats);
 
+// Where a parametrization's time went: seconds per stage and per solver step, iteration counts
+// and the largest system (`quadify param` and the remesher's report, under param.profile).
+nlohmann::json param_profile_json(const param::ParamStats& stats);
+
 // Sizing options shared by `param` and the remesher (paper section 7, isotropic scaling).
 struct SizingArgs {
   bool adaptive = false;     // --adaptive: curvature-adaptive sizes (param::adaptive_face_size)
