@@ -659,6 +659,15 @@ const ConstrainedReduction& PinnedLayout::reduction() const { return impl_->ext;
 int PinnedLayout::n_free() const { return impl_->n(); }
 const Eigen::VectorXd& PinnedLayout::y() const { return impl_->y; }
 bool PinnedLayout::is_pinned(int j) const { return impl_->state[j] == 1; }
+void PinnedLayout::unpin(int j) {
+  if (j >= 0 && j < impl_->n() && impl_->state[j] == 1) impl_->state[j] = 0;
+}
+PinnedLayout::Saved PinnedLayout::saved() const { return {impl_->y, impl_->x, impl_->state}; }
+void PinnedLayout::restore(const Saved& s) {
+  impl_->y = s.y;
+  impl_->x = s.x;
+  impl_->state = s.state;
+}
 int PinnedLayout::n_flipped() const { return count_flipped(impl_->domain, impl_->x); }
 
 Eigen::VectorXd PinnedLayout::x() const {

@@ -240,6 +240,17 @@ class PinnedLayout {
   // of iterations; *status is kNumericalFailure when a factorization fails.
   int minimize(int max_iterations, double relative_tolerance, core::Status* status);
 
+  // Frees the pinned variable y_j (pin() may then move it to another value).
+  void unpin(int j);
+  // The variables and which of them are pinned: a trial (unpin, pin, minimize) can be undone
+  // exactly by restore(saved()).
+  struct Saved {
+    Eigen::VectorXd y, x;
+    std::vector<char> state;
+  };
+  Saved saved() const;
+  void restore(const Saved& s);
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
