@@ -334,6 +334,17 @@ TEST(QuantizeSeamless, DefaultDensityIsAtLeastFiveThousandQuads) {
   EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
 }
 
+// The parametrization the remesher makes for a quantization at qo's density: symmetric Dirichlet,
+// cone pairs within a few quads cancelled, cones of index 3 split.
+param::ParamResult remesher_param(const core::TriMesh& mesh, const quantize::QuantizeOptions& qo) {
+  param::ParamOptions po;
+  po.energy = param::Energy::kSymmetricDirichlet;
+  po.cone_pair_distance = quantize::recommended_cone_pair_distance(mesh, qo);
+  po.cone_pair_max_hops = quantize::kRecommendedConePairHops;
+  po.cone_split_distance = quantize::target_edge_length(mesh, qo);
+  return param::compute_seamless_param(mesh, po);
+}
+
 // The re-optimizations grow the map by a few percent, differently from mesh to mesh and scale to
 // scale; the count correction runs the rounding again at a corrected scale while the count is
 // off by more than count_tolerance and keeps the map closest to the target. Without a target
@@ -345,12 +356,7 @@ TEST(QuantizeSeamless, CountCorrectionBringsTheQuadsCloserToTheTarget) {
     quantize::QuantizeOptions qo;
     qo.target_faces = target;
     qo.count_tolerance = 0.015;
-    param::ParamOptions po;  // as the remesher's: cone pairs within a few quads cancelled
-    po.energy = param::Energy::kSymmetricDirichlet;
-    po.cone_pair_distance = quantize::recommended_cone_pair_distance(mesh, qo);
-    po.cone_pair_max_hops = quantize::kRecommendedConePairHops;
-    po.cone_split_distance = quantize::target_edge_length(mesh, qo);
-    const param::ParamResult p = param::compute_seamless_param(mesh, po);
+    const param::ParamResult p = remesher_param(mesh, qo);
     ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
     qo.max_count_corrections = 0;
     const quantize::QuantizeResult plain = quantize::quantize_seamless(mesh, p, qo);
@@ -379,15 +385,10 @@ TEST(QuantizeSeamless, CountCorrectionBringsTheQuadsCloserToTheTarget) {
 TEST(QuantizeSeamless, CountAdjustmentMovesTheCountToTheTarget) {
   const core::TriMesh mesh = load("spot.obj");
   int n_adjusted = 0;
-  for (const int target : {500, 800}) {  // spot at 500: 526 quads without the adjustment, 500 with
+  for (const int target : {500, 800}) {  // spot at 500: 526 quads without the adjustment
     quantize::QuantizeOptions qo;
     qo.target_faces = target;
-    param::ParamOptions po;  // as the remesher's
-    po.energy = param::Energy::kSymmetricDirichlet;
-    po.cone_pair_distance = quantize::recommended_cone_pair_distance(mesh, qo);
-    po.cone_pair_max_hops = quantize::kRecommendedConePairHops;
-    po.cone_split_distance = quantize::target_edge_length(mesh, qo);
-    const param::ParamResult p = param::compute_seamless_param(mesh, po);
+    const param::ParamResult p = remesher_param(mesh, qo);
     ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
     const quantize::QuantizeResult plain = quantize::quantize_seamless(mesh, p, qo);  // off by default
     ASSERT_TRUE(plain.status.is_ok()) << target << ": " << plain.status.to_string();
