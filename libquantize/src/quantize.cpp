@@ -295,22 +295,21 @@ class Rounder {
     for (const int j : int_cols_)
       if (!layout_.is_pinned(j) && !released_[j]) return Outcome::kStuck;
     if (layout_.n_flipped() != 0) return Outcome::kStuck;
+    // The adjustment keeps only flip-free layouts (its trials are checked, and minimize() stays
+    // flip-free), so the count above still holds after it.
     tc = Clock::now();
     adjust_count();
     stats_->seconds_count_adjustment += seconds_since(tc);
-    if (!status_.is_ok()) return Outcome::kFailed;
-    return layout_.n_flipped() == 0 ? Outcome::kDone : Outcome::kStuck;
+    return status_.is_ok() ? Outcome::kDone : Outcome::kFailed;
   }
 
   // Symmetric Dirichlet energy of the map with the scale `unit` divided out, per unit of surface
-  // area (4 for an isometry).
-  double map_energy(const Eigen::VectorXd& x, double unit) const {
+  // area (4 for an isometry); face_area: the mesh's triangle areas.
+  double map_energy(const Eigen::VectorXd& x, double unit, const std::vector<double>& face_area) const {
     double e = 0, area = 0;
     for (int f = 0; f < mesh_.n_faces(); ++f) {
       const Eigen::Vector2d sv = face_singular_values(mesh_, cl_, x, f) / unit;
-      const Eigen::Vector3d p0 = mesh_.V.row(mesh_.F(f, 0)), p1 = mesh_.V.row(mesh_.F(f, 1)),
-                            p2 = mesh_.V.row(mesh_.F(f, 2));
-      const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+      const double a = face_area[f];
       if (!(sv[1] > 0)) return std::numeric_limits<double>::infinity();
       e += a * (sv[0] * sv[0] + sv[1] * sv[1] + 1 / (sv[0] * sv[0]) + 1 / (sv[1] * sv[1]));
       area += a;
@@ -335,6 +334,12 @@ class Rounder {
     std::vector<int> stamp(nf, -1);
     // The map's scale (UV units per model unit), which the energy below divides out.
     const double unit = std::sqrt(uv_area(cl_, layout_.x(), nf) / surface_area(mesh_));
+    std::vector<double> face_area(nf);
+    for (int f = 0; f < nf; ++f) {
+      const Eigen::Vector3d p0 = mesh_.V.row(mesh_.F(f, 0)), p1 = mesh_.V.row(mesh_.F(f, 1)),
+                            p2 = mesh_.V.row(mesh_.F(f, 2));
+      face_area[f] = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+    }
     for (int round = 0; round < opt_.max_count_adjustments; ++round) {
       const Eigen::VectorXd x = layout_.x();
       const long long count = std::llround(uv_area(cl_, x, nf));
@@ -345,6 +350,8 @@ class Rounder {
         int col, delta;
       };
       std::vector<Move> moves;
+      Eigen::VectorXd moved = x;  // x with one column's move applied, undone after each move
+      std::vector<double> base;   // the touched faces' areas in x
       for (const int j : int_cols_) {
         if (!layout_.is_pinned(j) || released_[j]) continue;
         std::vector<int> faces;
@@ -355,11 +362,13 @@ class Rounder {
                 stamp[f] = j;
                 faces.push_back(f);
               }
+        base.clear();
+        for (const int f : faces) base.push_back(face_uv_area(cl_, x, f));
         for (const int delta : {-1, 1}) {
-          Eigen::VectorXd moved = x;
           for (Eigen::SparseMatrix<double>::InnerIterator it(P, j); it; ++it) moved[it.row()] += delta * it.value();
           double change = 0;
-          for (const int f : faces) change += face_uv_area(cl_, moved, f) - face_uv_area(cl_, x, f);
+          for (size_t i = 0; i < faces.size(); ++i) change += face_uv_area(cl_, moved, faces[i]) - base[i];
+          for (Eigen::SparseMatrix<double>::InnerIterator it(P, j); it; ++it) moved[it.row()] = x[it.row()];
           const long long dc = std::llround(change);
           if (std::abs(gap - dc) < std::abs(gap)) moves.push_back({std::abs(gap - dc), std::abs(dc), j, delta});
         }
@@ -367,7 +376,7 @@ class Rounder {
       std::sort(moves.begin(), moves.end(), [](const Move& a, const Move& b) {
         return std::tie(a.miss, a.change, a.col, a.delta) < std::tie(b.miss, b.change, b.col, b.delta);
       });
-      const double energy = map_energy(x, unit);
+      const double energy = map_energy(x, unit, face_area);
       // The kCountAdjustTries moves that bring the count closest are tried; of those whose
       // energy growth is within their budget (kAdjustEnergyPerCount times the share of the target
       // they gain, at most kMaxAdjustEnergyGrowth), the one of least growth per quad gained is kept.
@@ -382,7 +391,7 @@ class Rounder {
         const std::vector<char> pinned = pin({{m.col, value}});
         if (!status_.is_ok()) return;
         const bool valid = pinned[0] && layout_.is_pinned(m.col) && layout_.n_flipped() == 0;
-        const double growth = valid ? map_energy(layout_.x(), unit) / energy - 1 : std::numeric_limits<double>::infinity();
+        const double growth = valid ? map_energy(layout_.x(), unit, face_area) / energy - 1 : std::numeric_limits<double>::infinity();
         const double gained = static_cast<double>(std::abs(gap) - m.miss);
         const double budget = std::min(kMaxAdjustEnergyGrowth - 1, kAdjustEnergyPerCount * gained / opt_.target_faces);
         const double cost = std::max(0.0, growth) / gained;
