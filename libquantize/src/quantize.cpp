@@ -321,7 +321,11 @@ class Rounder {
   // trying the moves of one pinned integer column by ±1 that bring the count closest (and closer)
   // and keeping the cheapest within its energy budget; a trial is undone exactly (restore).
   void adjust_count() {
-    if (opt_.target_faces <= 0 || opt_.max_count_adjustments <= 0) return;
+    // The count asked for: target_faces, or the default density's (an edge length asks for none).
+    const long long target = opt_.target_faces > 0 ? opt_.target_faces
+                             : opt_.edge_length > 0 ? 0
+                                                    : default_target_faces(mesh_);
+    if (target <= 0 || opt_.max_count_adjustments <= 0) return;
     const int nf = mesh_.n_faces();
     const Eigen::SparseMatrix<double> P = layout_.reduction().P;  // column-major copy
     const int n_copy_vars = 2 * cl_.n_copies();
@@ -343,8 +347,8 @@ class Rounder {
     for (int round = 0; round < opt_.max_count_adjustments; ++round) {
       const Eigen::VectorXd x = layout_.x();
       const long long count = std::llround(uv_area(cl_, x, nf));
-      const long long gap = opt_.target_faces - count;
-      if (std::abs(gap) <= std::llround(kCountAdjustTolerance * opt_.target_faces)) return;
+      const long long gap = target - count;
+      if (std::abs(gap) <= std::llround(kCountAdjustTolerance * target)) return;
       struct Move {
         long long miss, change;
         int col, delta;
@@ -393,7 +397,7 @@ class Rounder {
         const bool valid = pinned[0] && layout_.is_pinned(m.col) && layout_.n_flipped() == 0;
         const double growth = valid ? map_energy(layout_.x(), unit, face_area) / energy - 1 : std::numeric_limits<double>::infinity();
         const double gained = static_cast<double>(std::abs(gap) - m.miss);
-        const double budget = std::min(kMaxAdjustEnergyGrowth - 1, kAdjustEnergyPerCount * gained / opt_.target_faces);
+        const double budget = std::min(kMaxAdjustEnergyGrowth - 1, kAdjustEnergyPerCount * gained / target);
         const double cost = std::max(0.0, growth) / gained;
         if (growth <= budget && cost < best_cost) {
           best_cost = cost;
@@ -1010,6 +1014,10 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     area3d = param::sized_area(mesh, options.face_size, options.face_metric);
   }
   const double area_uv = uv_area(cl, cl.x, nf);
+  // The quad count asked for, explicitly or by the default density (an edge length asks for none).
+  const int count_target = options.target_faces > 0 ? options.target_faces
+                           : options.edge_length > 0 ? 0
+                                                     : default_target_faces(mesh);
   double scale = 0;
   if (options.target_faces > 0) {
     scale = std::sqrt(options.target_faces / area_uv);
@@ -1018,7 +1026,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   } else {
     scale = std::sqrt(default_target_faces(mesh) / area_uv);
   }
-  if (options.target_faces > 0 && options.count_tolerance > 0) scale /= std::sqrt(1 + kExpectedGrowth);
+  if (count_target > 0 && options.count_tolerance > 0) scale /= std::sqrt(1 + kExpectedGrowth);
   if (!(scale > 0) || !std::isfinite(scale)) {
     out.status =
         core::Status::invalid_input("cannot scale a map of UV area " + std::to_string(area_uv));
@@ -1272,8 +1280,8 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   // and the average one, without releasing features, and the map closest to the target is kept;
   // a run that dead-ends, flips or keeps fewer feature lines leaves the map as it is (the next
   // one tries a grid finer by half a near_scale_step).
-  if (best && options.target_faces > 0 && options.count_tolerance > 0) {
-    const double target = options.target_faces;
+  if (best && count_target > 0 && options.count_tolerance > 0) {
+    const double target = count_target;
     double best_area = uv_area(cl, *best, nf);
     double last_growth = best_area / (st.scale * st.scale * area_uv) - 1;
     double stuck_scale = 0;  // of the last run, when it was not usable

@@ -332,6 +332,20 @@ TEST(QuantizeSeamless, DefaultDensityIsAtLeastFiveThousandQuads) {
   ASSERT_TRUE(q.status.is_ok()) << q.status.to_string();
   EXPECT_NEAR(q.stats.uv_area, 5000, kQuadCountTolerance * 5000);
   EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
+  // The count adjustment aims at the default density's count as at a target's, and at none
+  // with an edge length.
+  quantize::QuantizeOptions adjusting = defaults;
+  adjusting.max_count_adjustments = 8;
+  const quantize::QuantizeResult a = quantize::quantize_seamless(box, p, adjusting);
+  ASSERT_TRUE(a.status.is_ok()) << a.status.to_string();
+  EXPECT_GT(a.stats.n_count_adjustments, 0) << q.stats.uv_area << " quads without it";
+  EXPECT_LT(std::abs(a.stats.uv_area - 5000), std::abs(q.stats.uv_area - 5000)) << q.stats.uv_area;
+  EXPECT_EQ(a.stats.n_flipped, 0);
+  EXPECT_EQ(test::integer_seamless_violation(a.uv), "");
+  adjusting.edge_length = quantize::target_edge_length(box, defaults);
+  const quantize::QuantizeResult e = quantize::quantize_seamless(box, p, adjusting);
+  ASSERT_TRUE(e.status.is_ok()) << e.status.to_string();
+  EXPECT_EQ(e.stats.n_count_adjustments, 0);
 }
 
 // The parametrization the remesher makes for a quantization at qo's density: symmetric Dirichlet,

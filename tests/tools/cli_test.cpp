@@ -362,14 +362,17 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
   EXPECT_LT(std::abs(after - 500), std::abs(before - 500)) << before << " -> " << after << " quads";
   EXPECT_LE(on["quantize"]["count_corrections_kept"].get<int>(),
             on["quantize"]["count_corrections"].get<int>());
-  // Without a count to aim at (an edge length, or the default density) it is refused, not ignored.
-  std::string args;
-  args.append("'").append(data_path("spot.obj").string()).append("' -o '").append((dir_ / "e.obj").string());
-  args.append("' --edge-length 0.05 --count-tolerance 0.015");
-  const CliRun bad = quadify(args, dir_);
-  EXPECT_EQ(bad.exit_code, 2) << bad.err;
-  EXPECT_NE(bad.err.find("--target-faces"), std::string::npos) << bad.err;
-  EXPECT_FALSE(fs::exists(dir_ / "e.obj"));
+  // Without a count to aim at (an edge length) it is refused, not ignored, as is the count
+  // adjustment.
+  for (const char* option : {"--count-tolerance 0.015", "--count-adjustments 8"}) {
+    std::string args;
+    args.append("'").append(data_path("spot.obj").string()).append("' -o '").append((dir_ / "e.obj").string());
+    args.append("' --edge-length 0.05 ").append(option);
+    const CliRun bad = quadify(args, dir_);
+    EXPECT_EQ(bad.exit_code, 2) << option << ": " << bad.err;
+    EXPECT_NE(bad.err.find("--edge-length"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir_ / "e.obj"));
+  }
 }
 
 // --count-adjustments: spot at 1,500 quads comes out with 1,585 without it; moving a few integer

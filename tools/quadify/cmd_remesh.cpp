@@ -752,7 +752,8 @@ CommandRunner register_remesh(CLI::App& app) {
                                 "every handle keeps its quads)")
                      ->check(CLI::Range(1, 100'000'000))
                      ->type_name("N");
-  app.add_option("--edge-length", args->edge_length, "Quad edge length in model units (instead of --target-faces)")
+  auto* edge_length = app.add_option("--edge-length", args->edge_length,
+                                     "Quad edge length in model units (instead of --target-faces)")
       ->check(CLI::PositiveNumber)
       ->excludes(target)
       ->type_name("H");
@@ -811,22 +812,23 @@ CommandRunner register_remesh(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--count-adjustments", args->count_adjustments,
-                 "With --target-faces: after the integer rounding, move up to this many integer unknowns (seam "
+                 "With --target-faces or the default density (not with --edge-length): after the integer rounding, move up to this many integer unknowns (seam "
                  "translations, cone positions) by one unit each where that brings the quad count closer to "
                  "the target, keeping each move only if the map stays flip-free and its distortion energy "
                  "grows by at most the share of the target it gains (and 1%); the count is known exactly "
                  "before a move. 8 puts most meshes within 0.05% of the target, but the result differs "
                  "like another rounding would (Hausdorff distance up or down). 0 = off")
       ->check(CLI::Range(0, 1000))
+      ->excludes(edge_length)
       ->capture_default_str();
   app.add_option("--count-tolerance", args->count_tolerance,
-                 "With --target-faces: aim the count at the target (the rounding grows the map by 2-3% on "
+                 "With --target-faces or the default density (not with --edge-length): aim the count at the target (the rounding grows the map by 2-3% on "
                  "average) and, while it is further than this fraction from the target, run the integer "
                  "rounding again at a scale corrected by the growth measured (at most twice, each about as "
                  "long as the first), keeping the count closest to the target; 0.015 suits (mean error "
                  "2.9% -> 1.0% at 5,000 quads). 0 = off: a few percent more quads than asked, one rounding")
       ->check(CLI::NonNegativeNumber)
-      ->needs(target)
+      ->excludes(edge_length)
       ->capture_default_str();
   app.add_option("--time-budget", args->time_budget,
                  "Stop the quantization after this many seconds with a message naming the scale and the "

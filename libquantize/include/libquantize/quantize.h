@@ -54,9 +54,9 @@ struct QuantizeOptions {
   // releases in one run the next attempt starts (features rounded last, then none). 0: any dead
   // end drops to the next attempt.
   int feature_release_rounds = 32;
-  // Count correction (target_faces > 0 only; 0 = off, the default). The re-optimizations change
-  // the map's area (the quad count) by a few percent: +2.7% on average at 5,000 quads, ±2% from
-  // mesh to mesh and scale to scale. With count_tolerance > 0 the scale allows for the average
+  // Count correction (with target_faces or the default density, not with edge_length; 0 = off,
+  // the default). The re-optimizations change the map's area (the quad count) by a few percent:
+  // +2.7% on average at 5,000 quads, ±2% from mesh to mesh and scale to scale. With count_tolerance > 0 the scale allows for the average
   // growth, and while the count is further than count_tolerance × target from the target, the
   // rounding is run again at a scale corrected by the growth measured, up to
   // max_count_corrections times (each costs about what the first rounding did), and the map
@@ -66,7 +66,8 @@ struct QuantizeOptions {
   // costs time where it collides cones (feline: 12 → 24 s) and moves the figures both ways.
   double count_tolerance = 0;
   int max_count_corrections = 2;
-  // With target_faces: once the rounding is done, up to this many integer unknowns (a seam
+  // With target_faces, or the default density (not with edge_length, which asks for no count):
+  // once the rounding is done, up to this many integer unknowns (a seam
   // translation, a cone coordinate, a feature line) are moved by one unit each, where the quad
   // count that gives (known exactly before the move on a closed map: the count depends on the
   // integers alone) is closer to the target; a move is kept only if the map stays flip-free and
