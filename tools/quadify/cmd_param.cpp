@@ -110,11 +110,8 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"features", feature_json(feature_input, s)},
                      {"sizing", sizing.report},
                      {"curvature_alignment", direction_json(sizing, s)},
-                     {"seconds_cut", s.seconds_cut},
-                     {"seconds_optimize", s.seconds_optimize},
-                     {"seconds_local_estimation", s.seconds_local_estimation},
                      {"seconds_total", s.seconds_total},
-                     {"profile", param_profile_json(s)}};
+                     {"profile", param_profile_json(s)}};  // the seconds per stage and solver step
   report["metrics"] = {{"tau", number(m.tau)},
                        {"flipped", m.n_flipped},
                        {"degenerate", m.n_degenerate},
