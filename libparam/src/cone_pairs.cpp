@@ -326,8 +326,26 @@ constexpr double kMaxSectorOpening = 1.75;
 
 }  // namespace
 
+int turned_face(const CutMesh& cut, const SeamChange& change) {
+  if (change.delta % 2 == 0) return -1;
+  const CutSeam& s = cut.seams[change.seam];
+  return (change.delta > 0 ? s.he_b : s.he_a) / 3;
+}
+
 bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
                                 const ConePairCancellation& pair, const std::vector<int>& feature_row_face) {
+  // The rows of the features on the path's edges after their label flips (see turned_face).
+  std::unordered_map<int, int> row_face;  // edge → face, where it differs from feature_row_face
+  for (const SeamChange& ch : pair.changes) {
+    const CutSeam& s = cut.seams[ch.seam];
+    const int turned = turned_face(cut, ch);
+    if (turned >= 0 && feature_row_face[s.edge] == turned)
+      row_face[s.edge] = turned == s.he_a / 3 ? s.he_b / 3 : s.he_a / 3;
+  }
+  auto row_of = [&](int e) {
+    const auto it = row_face.find(e);
+    return it == row_face.end() ? feature_row_face[e] : it->second;
+  };
   // Quarter turns of map angle each vertex of the path gains at each of its path edges: raising
   // the matching of seam v0 → v1 (in face a) by one lowers v0's index (its angle grows) and
   // raises v1's.
@@ -367,7 +385,7 @@ bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut, c
     const int n = static_cast<int>(face.size());
     int start = -1;  // the position after the first feature edge crossed
     for (int i = 0; i < n && start < 0; ++i)
-      if (feature_row_face[crossed[i]] >= 0) start = (i + 1) % n;
+      if (row_of(crossed[i]) >= 0) start = (i + 1) % n;
     if (start < 0) continue;  // no feature at v: no sector
     // Sectors between consecutive features, from `start` on. A feature's row lives in one of its
     // two faces; a path edge along the feature turns the frames beyond it, so its gain counts
@@ -380,18 +398,18 @@ bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut, c
     };
     const int first = (start + n - 1) % n;  // the first feature's position
     double sector = 0, surface_sector = 0;
-    int quarters = feature_row_face[crossed[first]] == face[first] ? gain_at(crossed[first]) : 0;
+    int quarters = row_of(crossed[first]) == face[first] ? gain_at(crossed[first]) : 0;
     for (int j = 0; j < n; ++j) {
       const int i = (start + j) % n;
       sector += angle[i];
       surface_sector += surface_angle[i];
       const int e = crossed[i];
       const int gain = gain_at(e);
-      if (feature_row_face[e] < 0) {
+      if (row_of(e) < 0) {
         quarters += gain;
         continue;
       }
-      const bool row_before = feature_row_face[e] == face[i];
+      const bool row_before = row_of(e) == face[i];
       if (!row_before) quarters += gain;  // the sector before the feature is turned
       const double turned = sector + quarters * 0.5 * std::numbers::pi;
       if (turned < 0.25 * std::numbers::pi || (quarters > 0 && turned > kMaxSectorOpening * surface_sector))

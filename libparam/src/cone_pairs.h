@@ -95,7 +95,16 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
 // in a set of 24 left 791 flipped faces, and the halving that found it spent the failure budget
 // before three other pairs were tried. x: the layout (2·#copies); feature_row_face: per
 // EdgeTopology edge of cut.topo, the face whose half-edge carries its feature's row if it is an
-// aligned feature, else −1.
+// aligned feature, else −1. Features on the path's edges whose rows live in the turned face
+// (turned_face) count with their rows in the other face: their labels flip with the change.
+// The face whose frame a matching change turns against the other face of its seam, which keeps
+// its frame: raising the matching of seam (face a → face b) turns b, lowering it turns a (the
+// same side of a path all along it, since the changes leave its inner vertices' indices alone);
+// −1 for an even change, which turns no axis. A feature on a changed seam whose row lives in the
+// turned face keeps its direction against the other side with its u/v label flipped, which is
+// what the cancellation does (see path_closes_feature_sector).
+int turned_face(const CutMesh& cut, const SeamChange& change);
+
 bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut,
                                 const Eigen::VectorXd& x, const ConePairCancellation& pair,
                                 const std::vector<int>& feature_row_face);

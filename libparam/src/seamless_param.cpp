@@ -631,16 +631,37 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         new_matching[ch.seam] += ch.delta;
         changed[ch.seam] = 1;
       }
+    // Aligned features on the changed seams whose rows live in the turned faces flip their
+    // labels: they keep their direction against the other side (see turned_face), and a crease
+    // the path runs along stays straight.
+    std::vector<int> flipped;
+    std::vector<SparseRow> kept_rows = feature_rows, full_rows = feature_rows, flipped_rows;
+    for (size_t i = begin; i < end; ++i)
+      for (const SeamChange& ch : moves[i].changes) {
+        const int f = fs.edge_feature.empty() ? -1 : fs.edge_feature[cut.seams[ch.seam].edge];
+        if (f < 0 || (label[f] != 0 && label[f] != 1) || fs.halfedge[f] / 3 != turned_face(cut, ch)) continue;
+        if (std::find(flipped.begin(), flipped.end(), f) != flipped.end()) continue;
+        const SparseRow old_row = feature_row(cut, fs.halfedge[f], label[f]);
+        const auto at = std::find_if(full_rows.begin(), full_rows.end(),
+                                     [&](const SparseRow& r) { return r.entries == old_row.entries; });
+        if (at == full_rows.end()) continue;
+        flipped.push_back(f);
+        *at = feature_row(cut, fs.halfedge[f], label[f] ^ 1);
+        flipped_rows.push_back(*at);
+        const auto in_kept = std::find_if(kept_rows.begin(), kept_rows.end(),
+                                          [&](const SparseRow& r) { return r.entries == old_row.entries; });
+        if (in_kept != kept_rows.end()) kept_rows.erase(in_kept);
+      }
     std::vector<int> kept_matching = matching;
     for (int s = 0; s < n_seams; ++s)
       if (changed[s]) kept_matching[s] = INT_MIN;
     ConstraintEliminator kept = eliminate_seams(cut, kept_matching);
-    for (const SparseRow& row : feature_rows) kept.add_row(row);
+    for (const SparseRow& row : kept_rows) kept.add_row(row);
     const Reduction kept_red = kept.reduction(x);
     Eigen::VectorXd x_try = x;
     ConstraintEliminator full = eliminate_seams(cut, new_matching);
-    for (const SparseRow& row : feature_rows) full.add_row(row);
-    std::vector<SparseRow> new_rows;
+    for (const SparseRow& row : full_rows) full.add_row(row);
+    std::vector<SparseRow> new_rows = flipped_rows;
     double edge_sq = 0;
     for (int s = 0; s < n_seams; ++s)
       if (changed[s]) {
@@ -688,6 +709,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     }
     if (ok) {
       matching = std::move(new_matching);
+      feature_rows = std::move(full_rows);
+      for (const int f : flipped) label[f] ^= 1;
       elim = std::move(full);
       red_problem.reset();
       red = std::move(tr.reduction);

@@ -118,45 +118,53 @@ TEST(ConePairs, SurfacePairsTakeTheSeamPathOfANearPair) {
   EXPECT_TRUE(find_surface_cone_pairs(m, cut, index, 10, avoid).empty());
 }
 
-// The sectors between aligned features round a path's vertices: the negative end loses a quarter
-// of map angle in the sector that holds the path's edge, so a sector of one face (about 60° here)
-// closes, while one feature alone bounds no sector; the positive end gains a quarter, and a sector
-// of one face opened to 60° + 90° is more than 1.75 times its angle on the surface.
+// The sectors between aligned features round a path's vertices. Raising seam 0's matching turns
+// its face b against face a (turned_face), lowers v's index (v gains a quarter of map angle) and
+// raises w's (w loses one), in the sectors on the turned side of the path's edge. With a feature
+// along the path's edge and another on the other edge at w of one of the seam's faces, the
+// one-face sector (about 60° here) is on the fixed side (face a: the wide sector loses, fine) or
+// on the turned side (face b: it closes); at v, the one-face sector on the turned side opened to
+// 150° is more than 1.75 times its surface angle. A row of the path's feature in face b counts as
+// in face a (its label flips with the change); one feature alone bounds no sector.
 TEST(ConePairs, APathMayNotCloseOrFlattenAFeatureSector) {
   const core::TriMesh m = test::make_icosphere(2);
   const CutMesh cut = cut_along_dual_tree(m, 0);
   const Eigen::VectorXd x = flatten(isometric_unfold(m, cut));
-  const int h = cut.seams[0].he_a, f = h / 3, k = h % 3;
-  const int v = m.F(f, k), w = m.F(f, (k + 1) % 3);
-  // Raising seam 0's matching lowers v's index (v gains angle) and raises w's (w loses angle).
+  const CutSeam& seam = cut.seams[0];
+  const int fa = seam.he_a / 3, ka = seam.he_a % 3, fb = seam.he_b / 3, kb = seam.he_b % 3;
+  const int v = m.F(fa, ka), w = m.F(fa, (ka + 1) % 3);
+  ASSERT_EQ(m.F(fb, kb), w);
+  EXPECT_EQ(turned_face(cut, {0, 1}), fb);
+  EXPECT_EQ(turned_face(cut, {0, -1}), fa);
+  EXPECT_EQ(turned_face(cut, {0, 2}), -1);
   ConePairCancellation pair;
   pair.positive_vertex = v;
   pair.negative_vertex = w;
   pair.changes = {{0, 1}};
   std::vector<int> row_face(cut.topo.n_edges(), -1);
   EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, row_face)) << "no features";
-  // Features on the path's edge (row in f) and on f's other edge at w: f alone lies between them
-  // at w, on the row's side of the path's edge, so w's loss is in the sector beyond it, which
-  // spans the rest of w's star.
-  const int at_w = cut.topo.face_edge(f, (k + 1) % 3);  // w → third vertex
-  row_face[cut.seams[0].edge] = f;
+  row_face[seam.edge] = fa;
   EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, row_face)) << "one feature bounds no sector";
-  row_face[at_w] = f;
-  EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, row_face)) << "the wide sector loses a quarter";
-  // With the path edge's row in the other face, f's sector at w is the one that loses: closed.
-  const int g = cut.seams[0].he_b / 3;
-  row_face[cut.seams[0].edge] = g;
-  EXPECT_TRUE(path_closes_feature_sector(m, cut, x, pair, row_face));
-  // At v: features on the path's edge and on f's other edge at v, rows in f: v's gain goes to the
-  // sector beyond the path's edge from f, the wide one; with the row in g, to f alone, which
-  // opens from about 60° to 150° (2.5×).
-  row_face.assign(cut.topo.n_edges(), -1);
-  const int at_v = cut.topo.face_edge(f, (k + 2) % 3);  // third vertex → v
-  row_face[at_v] = f;
-  row_face[cut.seams[0].edge] = f;
-  EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, row_face));
-  row_face[cut.seams[0].edge] = g;
-  EXPECT_TRUE(path_closes_feature_sector(m, cut, x, pair, row_face));
+  const int a_at_w = cut.topo.face_edge(fa, (ka + 1) % 3);  // w → third vertex of face a
+  const int b_at_w = cut.topo.face_edge(fb, (kb + 2) % 3);  // third vertex of face b → w
+  const int a_at_v = cut.topo.face_edge(fa, (ka + 2) % 3);
+  const int b_at_v = cut.topo.face_edge(fb, (kb + 1) % 3);
+  for (const int path_row : {fa, fb}) {
+    SCOPED_TRACE(path_row == fa ? "path feature's row in face a" : "in face b (flipped)");
+    std::vector<int> rows(cut.topo.n_edges(), -1);
+    rows[seam.edge] = path_row;
+    rows[a_at_w] = fa;
+    EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, rows)) << "w: the wide sector loses a quarter";
+    rows[a_at_w] = -1;
+    rows[b_at_w] = fb;
+    EXPECT_TRUE(path_closes_feature_sector(m, cut, x, pair, rows)) << "w: face b's sector closes";
+    rows[b_at_w] = -1;
+    rows[a_at_v] = fa;
+    EXPECT_FALSE(path_closes_feature_sector(m, cut, x, pair, rows)) << "v: the wide sector opens a little";
+    rows[a_at_v] = -1;
+    rows[b_at_v] = fb;
+    EXPECT_TRUE(path_closes_feature_sector(m, cut, x, pair, rows)) << "v: face b's sector opens 2.5x";
+  }
 }
 
 // Splits: a cone of index 3 gives one unit per call to a regular vertex about `distance` away
