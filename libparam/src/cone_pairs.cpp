@@ -24,6 +24,15 @@ std::vector<char> boundary_vertices(const core::TriMesh& mesh, const CutMesh& cu
   return on_boundary;
 }
 
+// Angle of face f's corner k in the layout x (2·#copies), signed (negative when the face is
+// flipped there).
+double uv_corner_angle(const CutMesh& cut, const Eigen::VectorXd& x, int f, int k) {
+  const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
+  const Eigen::Vector2d u = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 1) % 3])) - p;
+  const Eigen::Vector2d w = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 2) % 3])) - p;
+  return std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w));
+}
+
 }  // namespace
 
 std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
@@ -32,12 +41,7 @@ std::vector<int> vertex_indices(const core::TriMesh& mesh, const CutMesh& cut,
   std::vector<double> angle_sum(nv, 0.0);
   const std::vector<char> on_boundary = boundary_vertices(mesh, cut);
   for (int f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
-      const Eigen::Vector2d u = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 1) % 3])) - p;
-      const Eigen::Vector2d w = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 2) % 3])) - p;
-      angle_sum[mesh.F(f, k)] += std::atan2(u.x() * w.y() - u.y() * w.x(), u.dot(w));
-    }
+    for (int k = 0; k < 3; ++k) angle_sum[mesh.F(f, k)] += uv_corner_angle(cut, x, f, k);
   std::vector<int> index(nv, 0);
   for (int v = 0; v < nv; ++v)
     if (!on_boundary[v] && angle_sum[v] != 0)
@@ -367,10 +371,7 @@ bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut, c
     int f = f0, steps = 0;
     do {
       if (++steps > mesh.n_faces()) return false;  // not a manifold fan
-      const Eigen::Vector2d p = x.segment<2>(2 * cut.corner_copy[3 * f + k]);
-      const Eigen::Vector2d a = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 1) % 3])) - p;
-      const Eigen::Vector2d b = Eigen::Vector2d(x.segment<2>(2 * cut.corner_copy[3 * f + (k + 2) % 3])) - p;
-      angle.push_back(std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)));
+      angle.push_back(uv_corner_angle(cut, x, f, k));
       const Eigen::Vector3d q = mesh.V.row(mesh.F(f, k));
       const Eigen::Vector3d qa = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 1) % 3))) - q;
       const Eigen::Vector3d qb = Eigen::Vector3d(mesh.V.row(mesh.F(f, (k + 2) % 3))) - q;

@@ -85,18 +85,6 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
                                                    double distance, int max_hops,
                                                    const std::vector<char>& avoid = {});
 
-// Whether the matching changes of a seam path would close a sector between aligned features, a
-// check made before any solve. Round a vertex of the path, the aligned features split the map's
-// angle into sectors of whole quarter turns (their rows keep each feature on its u or v axis in
-// the frame of one face). The changes turn the frames beyond each path edge by its change: the
-// angle at the path's positive end grows by a quarter, at its negative end it shrinks by one,
-// and at an inner vertex one sector gains what another loses (nothing when the path's two edges
-// lie in one sector). A sector left with no angle cannot be laid out: on fandisk, one such pair
-// in a set of 24 left 791 flipped faces, and the halving that found it spent the failure budget
-// before three other pairs were tried. x: the layout (2·#copies); feature_row_face: per
-// EdgeTopology edge of cut.topo, the face whose half-edge carries its feature's row if it is an
-// aligned feature, else −1. Features on the path's edges whose rows live in the turned face
-// (turned_face) count with their rows in the other face: their labels flip with the change.
 // The face whose frame a matching change turns against the other face of its seam, which keeps
 // its frame: raising the matching of seam (face a → face b) turns b, lowering it turns a (the
 // same side of a path all along it, since the changes leave its inner vertices' indices alone);
@@ -105,6 +93,19 @@ std::vector<ConePairCancellation> find_cone_splits(const core::TriMesh& mesh, co
 // what the cancellation does (see path_closes_feature_sector).
 int turned_face(const CutMesh& cut, const SeamChange& change);
 
+// Whether the matching changes of a seam path would close a sector between aligned features, a
+// check made before any solve. Round a vertex of the path, the aligned features split the map's
+// angle into sectors of whole quarter turns (their rows keep each feature on its u or v axis in
+// the frame of one face). The changes turn the frames beyond each path edge by its change: the
+// angle at the path's positive end grows by a quarter, at its negative end it shrinks by one,
+// and at an inner vertex one sector gains what another loses (nothing when the path's two edges
+// lie in one sector). A sector left with no angle, or opened beyond 1.75 times its angle on the
+// surface (a right-angled crease corner laid out flat), cannot be laid out: on fandisk, one such pair
+// in a set of 24 left 791 flipped faces, and the halving that found it spent the failure budget
+// before three other pairs were tried. x: the layout (2·#copies); feature_row_face: per
+// EdgeTopology edge of cut.topo, the face whose half-edge carries its feature's row if it is an
+// aligned feature, else −1. Features on the path's edges whose rows live in the turned face
+// (turned_face) count with their rows in the other face: their labels flip with the change.
 bool path_closes_feature_sector(const core::TriMesh& mesh, const CutMesh& cut,
                                 const Eigen::VectorXd& x, const ConePairCancellation& pair,
                                 const std::vector<int>& feature_row_face);

@@ -642,15 +642,13 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         if (f < 0 || (label[f] != 0 && label[f] != 1) || fs.halfedge[f] / 3 != turned_face(cut, ch)) continue;
         if (std::find(flipped.begin(), flipped.end(), f) != flipped.end()) continue;
         const SparseRow old_row = feature_row(cut, fs.halfedge[f], label[f]);
-        const auto at = std::find_if(full_rows.begin(), full_rows.end(),
-                                     [&](const SparseRow& r) { return r.entries == old_row.entries; });
+        auto is_old = [&](const SparseRow& r) { return r.entries == old_row.entries; };
+        const auto at = std::find_if(full_rows.begin(), full_rows.end(), is_old);
         if (at == full_rows.end()) continue;
         flipped.push_back(f);
         *at = feature_row(cut, fs.halfedge[f], label[f] ^ 1);
         flipped_rows.push_back(*at);
-        const auto in_kept = std::find_if(kept_rows.begin(), kept_rows.end(),
-                                          [&](const SparseRow& r) { return r.entries == old_row.entries; });
-        if (in_kept != kept_rows.end()) kept_rows.erase(in_kept);
+        std::erase_if(kept_rows, is_old);
       }
     std::vector<int> kept_matching = matching;
     for (int s = 0; s < n_seams; ++s)

@@ -195,6 +195,13 @@ int default_target_faces(const core::TriMesh& mesh) {
   return std::max(kMinDefaultQuads, mesh.n_faces() / kDefaultTrianglesPerQuad);
 }
 
+// The quad count asked for: target_faces, or the default density's; 0 for an edge length, which
+// asks for none.
+int asked_count(const core::TriMesh& mesh, const QuantizeOptions& options) {
+  if (options.target_faces > 0) return options.target_faces;
+  return options.edge_length > 0 ? 0 : default_target_faces(mesh);
+}
+
 // Singular values (σ1 ≥ σ2) of face f's map from the surface to the UV plane.
 Eigen::Vector2d face_singular_values(const core::TriMesh& mesh, const param::CopyLayout& cl,
                                      const Eigen::VectorXd& x, int f) {
@@ -321,10 +328,7 @@ class Rounder {
   // trying the moves of one pinned integer column by ±1 that bring the count closest (and closer)
   // and keeping the cheapest within its energy budget; a trial is undone exactly (restore).
   void adjust_count() {
-    // The count asked for: target_faces, or the default density's (an edge length asks for none).
-    const long long target = opt_.target_faces > 0 ? opt_.target_faces
-                             : opt_.edge_length > 0 ? 0
-                                                    : default_target_faces(mesh_);
+    const long long target = asked_count(mesh_, opt_);
     if (target <= 0 || opt_.max_count_adjustments <= 0) return;
     const int nf = mesh_.n_faces();
     const Eigen::SparseMatrix<double> P = layout_.reduction().P;  // column-major copy
@@ -1014,18 +1018,9 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
     area3d = param::sized_area(mesh, options.face_size, options.face_metric);
   }
   const double area_uv = uv_area(cl, cl.x, nf);
-  // The quad count asked for, explicitly or by the default density (an edge length asks for none).
-  const int count_target = options.target_faces > 0 ? options.target_faces
-                           : options.edge_length > 0 ? 0
-                                                     : default_target_faces(mesh);
-  double scale = 0;
-  if (options.target_faces > 0) {
-    scale = std::sqrt(options.target_faces / area_uv);
-  } else if (options.edge_length > 0) {
-    scale = std::sqrt(area3d / area_uv) / options.edge_length;
-  } else {
-    scale = std::sqrt(default_target_faces(mesh) / area_uv);
-  }
+  const int count_target = asked_count(mesh, options);
+  double scale = count_target > 0 ? std::sqrt(count_target / area_uv)
+                                  : std::sqrt(area3d / area_uv) / options.edge_length;
   if (count_target > 0 && options.count_tolerance > 0) scale /= std::sqrt(1 + kExpectedGrowth);
   if (!(scale > 0) || !std::isfinite(scale)) {
     out.status =

@@ -56,8 +56,9 @@ struct QuantizeOptions {
   int feature_release_rounds = 32;
   // Count correction (with target_faces or the default density, not with edge_length; 0 = off,
   // the default). The re-optimizations change the map's area (the quad count) by a few percent:
-  // +2.7% on average at 5,000 quads, ±2% from mesh to mesh and scale to scale. With count_tolerance > 0 the scale allows for the average
-  // growth, and while the count is further than count_tolerance × target from the target, the
+  // +2.7% on average at 5,000 quads, ±2% from mesh to mesh and scale to scale. With
+  // count_tolerance > 0 the scale allows for the average growth, and while the count is further
+  // than count_tolerance × target from the target, the
   // rounding is run again at a scale corrected by the growth measured, up to
   // max_count_corrections times (each costs about what the first rounding did), and the map
   // closest to the target is kept (a run that dead-ends, or keeps fewer feature lines, changes
