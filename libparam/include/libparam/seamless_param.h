@@ -177,9 +177,9 @@ struct ParamOptions {
   // 0 = all hardware threads. The result does not depend on this number. (CHOLMOD's own
   // OpenMP/BLAS threads are not governed by it.)
   int threads = 0;
-  // Optional progress callback (stage "round": batch step of n_steps; stage "tau": exponent of
-  // the L^p continuation, out of 64). Calls are serialized, but with several components they may
-  // come from worker threads.
+  // Optional progress callback (stage "round": batch step of n_steps; "cone pairs": pass of the
+  // cone-pair cancellation, out of 4; stage "tau": exponent of the L^p continuation, out of 64).
+  // Calls are serialized, but with several components they may come from worker threads.
   std::function<void(const std::string& stage, int step, int n_steps)> progress;
   // Optional: asked once the matchings are final (after the last batch, the cone-pair
   // cancellation and the cone splits), before τ's L^p continuation, with the number of cones;
