@@ -94,6 +94,8 @@ TEST_F(CliSlow, WingnutKeepsItsShortSharpEdgesAndItsNarrowBands) {
 // mannequin-devil at 5,000 quads: its creases get feature-strip sizing, but the map they shape
 // has a cone of index 3 at a horn tip, so the remesher drops them; the sizing goes with them
 // (kept, the quads shrank along bands of creases no longer aligned: Hausdorff 0.0137, above 1%).
+// The count adjustment then brings its 5,220 quads to 5,000, but those are farther from the
+// input (Hausdorff 0.0132 against 0.0089: above 1%): the remesher keeps the quads before it.
 TEST_F(CliSlow, MannequinDropsItsFeatureSizingWithItsFeatures) {
   if (!has("mannequin-devil.obj")) GTEST_SKIP() << "no mannequin-devil";
   const nlohmann::json report = remesh("mannequin-devil.obj");
@@ -104,6 +106,8 @@ TEST_F(CliSlow, MannequinDropsItsFeatureSizingWithItsFeatures) {
   EXPECT_EQ(report["quads"]["non_quads"], 0);
   EXPECT_EQ(report["quads"]["flipped_quads"], 0);
   EXPECT_LT(report["quads"]["hausdorff_sym"].get<double>(), 0.01);
+  EXPECT_GT(report["quantize"]["count_adjustments"].get<int>(), 0);
+  EXPECT_EQ(report["quantize"]["count_adjustment_undone"], true);
 }
 
 // casting at 1,000 quads: one of its bars is about one quad around, and a rounding may close the

@@ -303,7 +303,11 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   const auto report = nlohmann::json::parse(slurp(dir_ / "r.json"));
   EXPECT_EQ(report["command"], "remesh");
   EXPECT_EQ(report["quantize"]["flipped"], 0);
-  EXPECT_EQ(report["quantize"]["count_adjustments"], 0) << "off by default";
+  // The count adjustment is on by default below 60,000 triangles: spot's rounding gives 1,585
+  // quads for 1,500 (see RemeshCountAdjustmentsMoveTheCountToTheTarget).
+  EXPECT_GT(report["quantize"]["count_adjustments"].get<int>(), 0) << "on by default";
+  EXPECT_EQ(report["quantize"]["count_adjustment_undone"], false);
+  EXPECT_NEAR(report["quads"]["faces"].get<int>(), 1500, 0.005 * 1500);
   // Where the parametrization's time went, as `quadify param` reports it.
   const auto& profile = report["param"]["profile"];
   EXPECT_GT(profile["seconds_factorize"].get<double>(), 0);
@@ -353,9 +357,11 @@ TEST_F(CliTest, RemeshSummaryGivesTheCaptureAndWarnsWhenCoarse) {
 // --count-tolerance: spot at 500 quads comes out with 526 without it (the rounding grows the
 // map), near 500 with it; the report counts the roundings run again.
 TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
-  const nlohmann::json off = remesh_report(data_path("spot.obj"), 500, "");
+  // (The count adjustment, on by default, is left out: it would move both counts.)
+  const nlohmann::json off = remesh_report(data_path("spot.obj"), 500, "--count-adjustments 0");
   EXPECT_EQ(off["quantize"]["count_corrections"], 0);
-  const nlohmann::json on = remesh_report(data_path("spot.obj"), 500, "--count-tolerance 0.015");
+  const nlohmann::json on =
+      remesh_report(data_path("spot.obj"), 500, "--count-tolerance 0.015 --count-adjustments 0");
   EXPECT_EQ(on["quads"]["non_quads"], 0);
   EXPECT_EQ(on["quads"]["flipped_quads"], 0);
   const int before = off["quads"]["faces"].get<int>(), after = on["quads"]["faces"].get<int>();
@@ -379,6 +385,9 @@ TEST_F(CliTest, RemeshCountToleranceBringsTheCountToTheTarget) {
 // unknowns by a unit each (the count known before each move) brings it within 0.5% of 1,500,
 // flip-free, on the same rounding.
 TEST_F(CliTest, RemeshCountAdjustmentsMoveTheCountToTheTarget) {
+  const nlohmann::json off = remesh_report(data_path("spot.obj"), 1500, "--count-adjustments 0");
+  EXPECT_EQ(off["quantize"]["count_adjustments"], 0);
+  EXPECT_GT(std::abs(off["quads"]["faces"].get<int>() - 1500), 0.005 * 1500) << "nothing to adjust";
   const nlohmann::json on = remesh_report(data_path("spot.obj"), 1500, "--count-adjustments 8");
   EXPECT_GT(on["quantize"]["count_adjustments"].get<int>(), 0);
   EXPECT_LE(on["quantize"]["count_adjustments"].get<int>(), 8);
