@@ -1361,10 +1361,10 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   // Exact verification of Def. 3.2 (of the map before its count adjustment too, which the
   // result keeps when it is exact and flip-free).
   auto verify_exact = [&](const Eigen::VectorXd& x, int* n_rounded) {
-    *n_rounded = 0;
+    int rounded = 0;
     for (size_t i = 0; i < candidates.size(); ++i) {
       const double v = candidates[i].value(x);
-      *n_rounded += v == std::round(v);
+      rounded += v == std::round(v);
       if (v != std::round(v) && !candidates[i].is_feature)
         return core::Status::internal("integer quantity " + std::to_string(i) + " is " +
                                       std::to_string(v) + ", not an exact integer after snapping");
@@ -1379,6 +1379,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
         return core::Status::internal("seam between faces " + std::to_string(s.face_a) + " and " +
                                       std::to_string(s.face_b) + " is not exactly seamless after snapping");
     }
+    if (n_rounded) *n_rounded = rounded;
     return core::Status::ok();
   };
   const Eigen::VectorXd& x = *best;
@@ -1389,8 +1390,7 @@ QuantizeResult run(const core::TriMesh& mesh, const param::ParamResult& seamless
   }
   for (int c = 0; c < 3 * nf; ++c)
     out.uv.corner_uv.row(c) = x.segment<2>(2 * cl.corner_copy[c]).transpose();
-  int n_rounded_unadjusted = 0;
-  if (best_unadjusted && verify_exact(*best_unadjusted, &n_rounded_unadjusted).is_ok() &&
+  if (best_unadjusted && verify_exact(*best_unadjusted, nullptr).is_ok() &&
       count_flipped(cl, *best_unadjusted, nf) == 0) {
     out.uv_unadjusted = out.uv;
     for (int c = 0; c < 3 * nf; ++c)

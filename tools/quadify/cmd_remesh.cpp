@@ -652,13 +652,16 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // the map before it by more than kAdjustedDistanceGrowth, or beyond kFarFromInput where those are
   // not (then the count stays as the rounding left it). Not after a refinement (its map was not
   // adjusted for the count asked).
+  // The metrics of the quads kept, where the comparison measured them (the report's measure
+  // step then reuses them: they do not depend on the UVs stripped below).
+  quadex::QuadMetricsOptions metric_options;
+  metric_options.hausdorff_samples = args.samples;
+  std::optional<quadex::QuadMetrics> kept_metrics;
   bool adjustment_undone = false;
   if (integer_map.uv_unadjusted.corner_uv.rows() > 0 && refinements == 0) {
     progress.begin("measure");
-    quadex::QuadMetricsOptions guard_options;
-    guard_options.hausdorff_samples = args.samples;
-    const double adjusted_distance =
-        quadex::compute_quad_metrics(extracted.quads, &mesh, guard_options).hausdorff_sym;
+    kept_metrics = quadex::compute_quad_metrics(extracted.quads, &mesh, metric_options);
+    const double adjusted_distance = kept_metrics->hausdorff_sym;
     progress.end();
     quantize::QuantizeResult plain_map = integer_map;
     plain_map.uv = std::move(plain_map.uv_unadjusted);
@@ -671,7 +674,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         if (plain_small.stats.n_replaced > 0) plain.quads = std::move(plain_small.quads);
         const quadex::RelaxStats plain_relax = relax(&plain);
         progress.begin("measure");
-        const quadex::QuadMetrics pm = quadex::compute_quad_metrics(plain.quads, &mesh, guard_options);
+        const quadex::QuadMetrics pm = quadex::compute_quad_metrics(plain.quads, &mesh, metric_options);
         progress.end();
         const bool farther = adjusted_distance > kAdjustedDistanceGrowth * pm.hausdorff_sym ||
                              (adjusted_distance > kFarFromInput && pm.hausdorff_sym < adjusted_distance);
@@ -685,6 +688,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
           integer_map = std::move(plain_map);
           extracted = std::move(plain);
           relax_stats = plain_relax;
+          kept_metrics = pm;
           adjustment_undone = true;
         }
       }
@@ -734,9 +738,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                        {"seconds", relax_stats.seconds}};
   if (args.measure) {
     progress.begin("measure");
-    quadex::QuadMetricsOptions metric_options;
-    metric_options.hausdorff_samples = args.samples;
-    const quadex::QuadMetrics m = quadex::compute_quad_metrics(extracted.quads, &mesh, metric_options);
+    const quadex::QuadMetrics m =
+        kept_metrics ? *kept_metrics : quadex::compute_quad_metrics(extracted.quads, &mesh, metric_options);
     progress.end();
     report["quads"] = {{"faces", m.n_faces},
                        {"non_quads", m.n_non_quads},
