@@ -185,7 +185,12 @@ class Repairer {
         return result;
       }
     }
-    if (opt_.orient_components) flip_folds(&rep);
+    if (opt_.orient_components) {
+      flip_folds(&rep);
+      // Fold flips can leave slivers folded over their new neighbours.
+      remove_zero_area(&rep);
+      compact_faces();
+    }
     remove_unreferenced(&rep, &result);
     try {
       const EdgeTopology topo = build_edge_topology(result.mesh);
@@ -265,70 +270,116 @@ class Repairer {
         list.erase(std::find(list.begin(), list.end(), f));
       }
     };
-    auto degenerate = [&](const Tri& t) { return is_zero_area(t) || is_cap(t); };
+    // A folded sliver (see RepairOptions::folded_sliver_angle_deg): obtuse, flat (its apex within
+    // kSliverHeight of its longest edge's length from that edge), and folded back over the
+    // neighbours across both its short edges.
+    constexpr double kSliverHeight = 0.05;
+    constexpr int kSliverPasses = 4;
+    const double fold_cos = std::cos(2 * std::numbers::pi / 3);  // normals more than 120° apart
+    auto longest_edge = [&](const Tri& t) {
+      int k_long = 0;
+      double best = -1.0;
+      for (int k = 0; k < 3; ++k) {
+        const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).norm();
+        if (len > best) best = len, k_long = k;
+      }
+      return std::make_pair(k_long, best);
+    };
+    auto sliver_shape = [&](const Tri& t) {
+      if (!(opt_.folded_sliver_angle_deg < 180) ||
+          max_angle(t) < opt_.folded_sliver_angle_deg * (std::numbers::pi / 180))
+        return false;
+      const double area2 = normal(t).norm(), length = longest_edge(t).second;
+      return area2 > 0 && area2 / length <= kSliverHeight * length;
+    };
+    bool any = false;
+    for (int f = 0; f < static_cast<int>(tris_.size()) && !any; ++f)
+      any = alive_[f] && (is_zero_area(tris_[f]) || is_cap(tris_[f]) || sliver_shape(tris_[f]));
+    if (!any) return;
+    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
+      if (alive_[f]) link(f);
+    auto folded_sliver = [&](const Tri& t) {
+      if (!sliver_shape(t)) return false;
+      const Eigen::Vector3d n = normal(t);
+      const int k_long = longest_edge(t).first;
+      for (int k = 0; k < 3; ++k) {
+        if (k == k_long) continue;
+        const auto& faces = edge_faces[edge_key(t[k], t[(k + 1) % 3])];
+        if (faces.size() != 2) return false;
+        const Tri& u = tris_[faces[0]] == t ? tris_[faces[1]] : tris_[faces[0]];
+        const Eigen::Vector3d m = normal(u);
+        if (!(m.norm() > 0) || n.normalized().dot(m.normalized()) > fold_cos) return false;
+      }
+      return true;
+    };
+    auto degenerate = [&](const Tri& t) { return is_zero_area(t) || is_cap(t) || folded_sliver(t); };
     std::deque<int> queue;
     for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
       if (alive_[f] && degenerate(tris_[f])) queue.push_back(f);
     if (queue.empty()) return;
-    for (int f = 0; f < static_cast<int>(tris_.size()); ++f)
-      if (alive_[f]) link(f);
     // Each split replaces one triangle by two; bound the work on pathological input.
     long long budget = 4 * static_cast<long long>(tris_.size()) + 16;
-    while (!queue.empty()) {
-      const int f = queue.front();
-      queue.pop_front();
-      if (!alive_[f]) continue;
-      const bool zero = is_zero_area(tris_[f]);
-      if (!zero && !is_cap(tris_[f])) continue;
-      const Tri t = tris_[f];
-      int k_long = 0;  // longest edge runs t[k_long] → t[k_long+1]
-      double best = -1.0;
-      for (int k = 0; k < 3; ++k) {
-        const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).squaredNorm();
-        if (len > best) best = len, k_long = k;
-      }
-      const int a = t[k_long], b = t[(k_long + 1) % 3], m = t[(k_long + 2) % 3];
-      const auto& across = edge_faces[edge_key(a, b)];
-      // A cap is only removed by a split that keeps the surface as it is: one neighbour, whose
-      // third vertex is not joined to m yet.
-      int g = -1, c = -1;
-      if (across.size() == 2) {
-        g = across[0] == f ? across[1] : across[0];
-        const Tri& u = tris_[g];
-        for (int v : u)
-          if (v != a && v != b) c = v;
-      }
-      if (!zero && (g < 0 || c == m || !edge_faces[edge_key(m, c)].empty())) continue;
-      if (!zero) {
-        // The two new triangles must face like the neighbour they replace.
-        const Eigen::Vector3d pa = V_.row(a), pb = V_.row(b), pc = V_.row(c), pm = V_.row(m);
-        const Eigen::Vector3d n = (pb - pa).cross(pc - pa);
-        if (n.dot((pm - pa).cross(pc - pa)) <= 0 || n.dot((pb - pm).cross(pc - pm)) <= 0) continue;
-        // Each removal lowers the largest angle where it acts, so removals cannot cycle.
-        if (std::max(max_angle({a, m, c}), max_angle({m, b, c})) >= max_angle(t)) continue;
-      }
-      unlink(f);
-      alive_[f] = 0;
-      ++(zero ? rep->degenerate_faces_removed : rep->caps_removed);
-      if (g < 0 || --budget < 0) continue;  // boundary or non-manifold: just drop
-      const Tri u = tris_[g];
-      int j = 0;
-      while (!((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))) ++j;
-      const int x = u[j], y = u[(j + 1) % 3];
-      if (c == m) {  // the neighbour is the same triangle reversed: both vanish
+    // A removal changes the neighbours of the faces around it, which can leave a sliver folded
+    // over its new neighbour: the faces are scanned again (a few passes) once the queue is empty.
+    for (int pass = 0; pass < kSliverPasses && !queue.empty(); ++pass) {
+      while (!queue.empty()) {
+        const int f = queue.front();
+        queue.pop_front();
+        if (!alive_[f]) continue;
+        const bool zero = is_zero_area(tris_[f]);
+        if (!zero && !is_cap(tris_[f]) && !folded_sliver(tris_[f])) continue;
+        const Tri t = tris_[f];
+        int k_long = 0;  // longest edge runs t[k_long] → t[k_long+1]
+        double best = -1.0;
+        for (int k = 0; k < 3; ++k) {
+          const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).squaredNorm();
+          if (len > best) best = len, k_long = k;
+        }
+        const int a = t[k_long], b = t[(k_long + 1) % 3], m = t[(k_long + 2) % 3];
+        const auto& across = edge_faces[edge_key(a, b)];
+        // A cap is only removed by a split that keeps the surface as it is: one neighbour, whose
+        // third vertex is not joined to m yet.
+        int g = -1, c = -1;
+        if (across.size() == 2) {
+          g = across[0] == f ? across[1] : across[0];
+          const Tri& u = tris_[g];
+          for (int v : u)
+            if (v != a && v != b) c = v;
+        }
+        if (!zero && (g < 0 || c == m || !edge_faces[edge_key(m, c)].empty())) continue;
+        if (!zero) {
+          // The two new triangles must face like the neighbour they replace.
+          const Eigen::Vector3d pa = V_.row(a), pb = V_.row(b), pc = V_.row(c), pm = V_.row(m);
+          const Eigen::Vector3d n = (pb - pa).cross(pc - pa);
+          if (n.dot((pm - pa).cross(pc - pa)) <= 0 || n.dot((pb - pm).cross(pc - pm)) <= 0) continue;
+          // Each removal lowers the largest angle where it acts, so removals cannot cycle.
+          if (std::max(max_angle({a, m, c}), max_angle({m, b, c})) >= max_angle(t)) continue;
+        }
+        unlink(f);
+        alive_[f] = 0;
+        ++(zero ? rep->degenerate_faces_removed : rep->caps_removed);
+        if (g < 0 || --budget < 0) continue;  // boundary or non-manifold: just drop
+        const Tri u = tris_[g];
+        int j = 0;
+        while (!((u[j] == a && u[(j + 1) % 3] == b) || (u[j] == b && u[(j + 1) % 3] == a))) ++j;
+        const int x = u[j], y = u[(j + 1) % 3];
+        if (c == m) {  // the neighbour is the same triangle reversed: both vanish
+          unlink(g);
+          alive_[g] = 0;
+          ++rep->degenerate_faces_removed;
+          continue;
+        }
         unlink(g);
         alive_[g] = 0;
-        ++rep->degenerate_faces_removed;
-        continue;
+        for (const Tri& n : {Tri{x, m, c}, Tri{m, y, c}}) {
+          tris_.push_back(n);
+          alive_.push_back(1);
+          link(static_cast<int>(tris_.size()) - 1);
+          if (degenerate(n)) queue.push_back(static_cast<int>(tris_.size()) - 1);
+        }
       }
-      unlink(g);
-      alive_[g] = 0;
-      for (const Tri& n : {Tri{x, m, c}, Tri{m, y, c}}) {
-        tris_.push_back(n);
-        alive_.push_back(1);
-        link(static_cast<int>(tris_.size()) - 1);
-        if (degenerate(n)) queue.push_back(static_cast<int>(tris_.size()) - 1);
-      }
+      for (int h = 0; h < static_cast<int>(tris_.size()); ++h)
+        if (alive_[h] && folded_sliver(tris_[h])) queue.push_back(h);
     }
   }
 

@@ -224,6 +224,55 @@ TEST(Repair, FoldedSliverIsFlippedAway) {
       << "the double-covered part cancels either way";
 }
 
+// Largest angle (degrees) between the normals of two triangles on an edge.
+double largest_normal_turn_deg(const TriMesh& m) {
+  const EdgeTopology topo = build_edge_topology(m);
+  auto normal = [&](int f) {
+    return (Eigen::Vector3d(m.V.row(m.F(f, 1))) - Eigen::Vector3d(m.V.row(m.F(f, 0))))
+        .cross(Eigen::Vector3d(m.V.row(m.F(f, 2))) - Eigen::Vector3d(m.V.row(m.F(f, 0))))
+        .normalized();
+  };
+  double best = 0;
+  for (int e = 0; e < topo.n_edges(); ++e) {
+    const int h = topo.edge_halfedge[e], t = topo.twin[h];
+    if (t < 0) continue;
+    best = std::max(best, std::acos(std::clamp(normal(h / 3).dot(normal(t / 3)), -1.0, 1.0)) * 180 / 3.14159265358979);
+  }
+  return best;
+}
+
+TEST(Repair, FoldedSliverAlongACreaseIsRemoved) {
+  // A 90° crease a-b between the floor (a, b, c) and the wall (m, a, p), (b, m, p); the sliver
+  // (b, a, m) between them has its vertex m 0.05 below the crease (174°, no cap), lies in the
+  // wall's plane and faces against it: its short edges would look like 180° creases beside the
+  // real one (block's CAD tessellation has such slivers along its creases).
+  const PolyMesh sliver = make_poly({{0, 0, 0}, {2, 0, 0}, {1, -1, 0}, {1, 0.001, -0.05}, {1, 0, 1}},
+                                    {{0, 1, 2}, {1, 0, 3}, {3, 0, 4}, {1, 3, 4}});
+  RepairOptions off;
+  off.folded_sliver_angle_deg = 180;
+  off.fold_angle_deg = 180;
+  const RepairResult kept = repair_mesh(sliver, off);
+  ASSERT_TRUE(kept.status.is_ok()) << kept.status.to_string();
+  EXPECT_EQ(kept.report.caps_removed, 0);
+  EXPECT_GT(largest_normal_turn_deg(kept.mesh), 170) << "the sliver is there, folded";
+  RepairOptions on = off;
+  on.folded_sliver_angle_deg = RepairOptions{}.folded_sliver_angle_deg;
+  const RepairResult r = repair_mesh(sliver, on);
+  ASSERT_TRUE(r.status.is_ok()) << r.status.to_string();
+  EXPECT_EQ(r.report.caps_removed, 1);
+  EXPECT_EQ(r.mesh.n_faces(), 4) << "the floor is split at the sliver's vertex";
+  EXPECT_EQ(r.mesh.n_vertices(), 5);
+  EXPECT_LT(largest_normal_turn_deg(r.mesh), 95) << "only the crease is left";
+  EXPECT_LT(largest_angle_deg(r.mesh), 150);
+  EXPECT_NO_THROW((void)build_edge_topology(r.mesh)) << "manifold and oriented";
+  // The defaults remove it too.
+  EXPECT_LT(largest_normal_turn_deg(repair_mesh(sliver).mesh), 95);
+  // A sliver that is not folded (its vertex just off the crease in the floor's plane) stays.
+  const PolyMesh flat = make_poly({{0, 0, 0}, {2, 0, 0}, {1, -1, 0}, {1, 0.05, 0}, {1, 0, 1}},
+                                  {{0, 1, 2}, {1, 0, 3}, {3, 0, 4}, {1, 3, 4}});
+  EXPECT_EQ(repair_mesh(flat, on).report.caps_removed, 0);
+}
+
 TEST(Repair, NeedleCollapsesByWelding) {
   // A vertex coincident with cube vertex 7, splitting edge (3,7): two zero-area triangles.
   PolyMesh m = cube_tris();

@@ -25,6 +25,12 @@ struct RepairOptions {
   // are already joined (the result would not be manifold). 180 = off. (Wider wedges between
   // two feature edges: flip_feature_wedges.)
   double cap_angle_deg = 178;
+  // A folded sliver, a triangle with an angle of at least this (degrees) whose far vertex lies
+  // within 5% of its longest edge's length from that edge and which is folded back over the
+  // neighbours across both its shorter edges (normals more than 120° apart), is removed
+  // like a cap: its two short edges look like creases beside the real one on its long edge (block
+  // has nine between 142° and 178°, wingnut three). 180 = off.
+  double folded_sliver_angle_deg = 120;
   // A fold: two triangles on an edge that lie almost on top of each other, face to face (their
   // normals more than this apart, degrees, and one's far vertex within 2% of the edge length
   // of the other's plane). CAD tessellations leave slivers folded over a neighbour along
