@@ -73,7 +73,9 @@ TEST_F(CliSlow, FandiskCreaseCornerIsMetByATentativeSnap) {
 // (param::feature_strip_vertex_size), so that both their creases are quad edges: feature capture
 // 0.945 → 0.964. With --no-feature-sizing the bands lose a crease (0.934; compared without the
 // cone pairs near over the surface, the pipeline the sizing was measured in: with them, the run
-// without sizing lands on another rounding, 0.960).
+// without sizing lands on another rounding, 0.960). Since the repair removes folded slivers
+// (three on wingnut), the run without sizing captures 0.957 against the default's 0.962: the
+// margin is smaller, the order the same.
 TEST_F(CliSlow, WingnutKeepsItsShortSharpEdgesAndItsNarrowBands) {
   if (!has("wingnut.obj")) GTEST_SKIP() << "no wingnut";
   const nlohmann::json report = remesh("wingnut.obj");
@@ -88,7 +90,7 @@ TEST_F(CliSlow, WingnutKeepsItsShortSharpEdgesAndItsNarrowBands) {
   const nlohmann::json off_report = remesh("wingnut.obj", "--no-feature-sizing --surface-cone-pairs off");
   ASSERT_FALSE(off_report.is_null());
   EXPECT_LT(off_report["quads"]["feature_capture"].get<double>(),
-            report["quads"]["feature_capture"].get<double>() - 0.01);
+            report["quads"]["feature_capture"].get<double>() - 0.002);
 }
 
 // mannequin-devil at 5,000 quads: its creases get feature-strip sizing, but the map they shape
