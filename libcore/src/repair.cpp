@@ -276,14 +276,15 @@ class Repairer {
     constexpr double kSliverHeight = 0.05;
     constexpr int kSliverPasses = 4;
     const double fold_cos = std::cos(2 * std::numbers::pi / 3);  // normals more than 120° apart
+    // The longest edge runs t[k] → t[k+1]: (k, its length).
     auto longest_edge = [&](const Tri& t) {
       int k_long = 0;
       double best = -1.0;
       for (int k = 0; k < 3; ++k) {
-        const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).norm();
+        const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).squaredNorm();
         if (len > best) best = len, k_long = k;
       }
-      return std::make_pair(k_long, best);
+      return std::make_pair(k_long, std::sqrt(best));
     };
     auto sliver_shape = [&](const Tri& t) {
       if (!(opt_.folded_sliver_angle_deg < 180) ||
@@ -326,15 +327,10 @@ class Repairer {
         const int f = queue.front();
         queue.pop_front();
         if (!alive_[f]) continue;
+        if (!degenerate(tris_[f])) continue;
         const bool zero = is_zero_area(tris_[f]);
-        if (!zero && !is_cap(tris_[f]) && !folded_sliver(tris_[f])) continue;
         const Tri t = tris_[f];
-        int k_long = 0;  // longest edge runs t[k_long] → t[k_long+1]
-        double best = -1.0;
-        for (int k = 0; k < 3; ++k) {
-          const double len = (V_.row(t[(k + 1) % 3]) - V_.row(t[k])).squaredNorm();
-          if (len > best) best = len, k_long = k;
-        }
+        const int k_long = longest_edge(t).first;
         const int a = t[k_long], b = t[(k_long + 1) % 3], m = t[(k_long + 2) % 3];
         const auto& across = edge_faces[edge_key(a, b)];
         // A cap is only removed by a split that keeps the surface as it is: one neighbour, whose

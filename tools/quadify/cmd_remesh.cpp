@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -797,6 +798,17 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   return kExitOk;
 }
 
+// An option that takes a number or "auto" (its default, shown as such in --help): `set` gets the
+// text; `check` validates it unless it is "auto".
+CLI::Option* add_auto_option(CLI::App& app, const std::string& name,
+                             std::function<void(const std::string&)> set, const std::string& help,
+                             const CLI::Validator& check, const std::string& type_name) {
+  return app.add_option_function<std::string>(name, std::move(set), help)
+      ->check([check](const std::string& text) { return text == "auto" ? std::string() : check(text); })
+      ->default_str("auto")
+      ->type_name(type_name);
+}
+
 }  // namespace
 
 CommandRunner register_remesh(CLI::App& app) {
@@ -851,21 +863,16 @@ CommandRunner register_remesh(CLI::App& app) {
                  "the distance of another)")
       ->check(CLI::Range(1, 2))
       ->capture_default_str();
-  app.add_option_function<std::string>(
-         "--cone-scale",
-         [args](const std::string& text) { args->cone_scale = text == "auto" ? -1 : std::stod(text); },
-         "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
-         "curvature details smaller than that make no cones of their own; ignored while features are "
-         "aligned. 0 = off; auto (the default): 1.4, then 1.96 if that copy cannot be used, when the "
-         "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
-         "characteristic| a closed surface needs (its cone count is then param.fine_cones in the "
-         "report), else off")
-      ->check([](const std::string& text) {
-        if (text == "auto") return std::string();
-        return CLI::NonNegativeNumber(text);
-      })
-      ->default_str("auto")
-      ->type_name("Q|auto");
+  add_auto_option(
+      app, "--cone-scale",
+      [args](const std::string& text) { args->cone_scale = text == "auto" ? -1 : std::stod(text); },
+      "Round the matchings on a copy of the mesh smoothed at this many quad edge lengths, so that "
+      "curvature details smaller than that make no cones of their own; ignored while features are "
+      "aligned. 0 = off; auto (the default): 1.4, then 1.96 if that copy cannot be used, when the "
+      "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
+      "characteristic| a closed surface needs (its cone count is then param.fine_cones in the "
+      "report), else off",
+      CLI::NonNegativeNumber, "Q|auto");
   app.add_option("--min-crease-quads", args->min_crease_quads,
                  "Leave the detected creases unaligned when every crease curve is shorter than this "
                  "many quad edges and none is a knife edge (median dihedral angle of at least 120 "
@@ -873,23 +880,18 @@ CommandRunner register_remesh(CLI::App& app) {
                  "short to shape the quads, which would add cones and distortion (0 = always align)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  auto* count_adjustments = app.add_option_function<std::string>(
-         "--count-adjustments",
-         [args](const std::string& text) { args->count_adjustments = text == "auto" ? -1 : std::stoi(text); },
-         "With --target-faces or the default density (not with --edge-length): after the integer "
-         "rounding, move up to this many integer unknowns (seam translations, cone positions) by one "
-         "unit each while the quad count is more than 0.5% off the target, where a move brings it "
-         "closer, keeping a move only if the map stays flip-free and its distortion energy grows by at "
-         "most the share of the target it gains (and 1%); the count is known exactly before a move, "
-         "and each move tried costs a whole-mesh solve. 0 = off; auto (the default): 8 up to 60,000 "
-         "input triangles, else 0. At 5,000 quads: 18 of 20 bench meshes within 0.5% of the target "
-         "(without: 4), the result differing like another rounding would (Hausdorff up or down)")
-      ->check([](const std::string& text) {
-        if (text == "auto") return std::string();
-        return CLI::Range(0, 1000)(text);
-      })
-      ->default_str("auto")
-      ->type_name("N|auto");
+  auto* count_adjustments = add_auto_option(
+      app, "--count-adjustments",
+      [args](const std::string& text) { args->count_adjustments = text == "auto" ? -1 : std::stoi(text); },
+      "With --target-faces or the default density (not with --edge-length): after the integer "
+      "rounding, move up to this many integer unknowns (seam translations, cone positions) by one "
+      "unit each while the quad count is more than 0.5% off the target, where a move brings it "
+      "closer, keeping a move only if the map stays flip-free and its distortion energy grows by at "
+      "most the share of the target it gains (and 1%); the count is known exactly before a move, "
+      "and each move tried costs a whole-mesh solve. 0 = off; auto (the default): 8 up to 60,000 "
+      "input triangles, else 0. At 5,000 quads: 17 of 20 bench meshes within 0.5% of the target "
+      "(without: 4), the result differing like another rounding would (Hausdorff up or down)",
+      CLI::Range(0, 1000), "N|auto");
   count_adjustments->excludes(edge_length);
   app.add_option("--count-tolerance", args->count_tolerance,
                  "With --target-faces or the default density (not with --edge-length): aim the count at the target (the rounding grows the map by 2-3% on "
