@@ -420,8 +420,30 @@ constexpr double kPinHeldBack = 0.05;
 struct PinnedLayout::Impl {
   struct Face {
     std::vector<int> ys;                             // reduced variables of the face
-    Eigen::Matrix<double, 4, Eigen::Dynamic> M;      // edge-vector coordinates = M·y[ys]
+    Eigen::Matrix<double, 4, Eigen::Dynamic> M;      // edge-vector coordinates = M·y[ys] (narrow)
+    int wide = -1;                                   // index among the wide faces, or -1
   };
+  // Wide faces (more free variables than PinnedLayoutOptions::wide_face_variables: with hundreds
+  // of cones, the loops around them are solved for translations, which then depend on every cone
+  // on one side of a seam, and a face along that seam on all of them) store no k×k Hessian: they
+  // are assembled in the internal coordinates, 6 per face, into Hx and mapped once per evaluation,
+  // H += Pwᵀ·Hx·Pw, whose entries the faces along one seam share (dragon at its default density
+  // had faces of 460 variables, 9.2e7 element entries, 3 GB). Per wide face: the local indices
+  // (2·corner + d) of its coordinates and the offsets of its 6×6 block in Hx's values; Pw: P's
+  // rows of those coordinates; s_entry: per entry of the product (a fixed pattern) its offset in
+  // H's values.
+  struct Wide {
+    std::vector<int> faces;
+    std::vector<int> var;                            // local index → internal variable
+    std::vector<std::array<int, 6>> local;
+    std::vector<std::array<int, 36>> hx_entry;
+    Eigen::SparseMatrix<double> Hx, Pw, PwT;
+    std::vector<int> s_entry;
+    std::vector<double> g6, h6;                      // per wide face: 6 and 36 values
+    Eigen::VectorXd gx;
+    bool empty() const { return faces.empty(); }
+  };
+  Wide wide;
   LayoutDomain domain;
   Reduction red;                  // internal variables
   ConstrainedReduction ext;       // external order
@@ -520,8 +542,23 @@ struct PinnedLayout::Impl {
             h4(2 * j + dir_axis[f], 2 * i + dir_axis[f]) +=
                 2 * dir_weight * a * dir_coef[f][j] * dir_coef[f][i];
         }
-      // M'·g4 and M'·h4·M column by column: no temporaries, no GEMM set-up for a k×k result.
       const Face& el = faces[f];
+      if (el.wide >= 0) {  // in the internal coordinates: x-edge (2j + d) = x_{j+1,d} − x_{0,d}
+        double* g6 = wide.g6.data() + 6 * el.wide;
+        double* h6 = wide.h6.data() + 36 * el.wide;
+        Eigen::Matrix<double, 4, 6> D = Eigen::Matrix<double, 4, 6>::Zero();
+        for (int j = 0; j < 2; ++j)
+          for (int d = 0; d < 2; ++d) {
+            D(2 * j + d, 2 * (j + 1) + d) = 1;
+            D(2 * j + d, d) = -1;
+          }
+        Eigen::Map<Eigen::Matrix<double, 6, 1>> g6_map(g6);
+        Eigen::Map<Eigen::Matrix<double, 6, 6>> h6_map(h6);
+        g6_map = D.transpose() * g4;
+        h6_map = D.transpose() * h4 * D;
+        return;
+      }
+      // M'·g4 and M'·h4·M column by column: no temporaries, no GEMM set-up for a k×k result.
       const Eigen::Index k = el.M.cols();
       double* fg = face_g.data() + g_base[f];
       double* fh = face_h.data() + h_base[f];
@@ -553,10 +590,20 @@ struct PinnedLayout::Impl {
         sum = 1;
       vals[e] = sum;
     });
+    if (!wide.empty()) add_wide(g);
     if (Hv) {  // the free rows' response to the non-free columns' displacement v
       Hv->setZero(n());
+      if (!wide.empty()) {
+        Eigen::VectorXd vn = Eigen::VectorXd::Zero(n());
+        for (int i = 0; i < n(); ++i)
+          if (state[i] != 0) vn[i] = (*v)[i];
+        const Eigen::VectorXd hv = wide.PwT * (wide.Hx * (wide.Pw * vn));
+        for (int i = 0; i < n(); ++i)
+          if (state[i] == 0) (*Hv)[i] += hv[i];
+      }
       for (int f = 0; f < nf; ++f) {
         const Face& el = faces[f];
+        if (el.wide >= 0) continue;
         const size_t k = el.ys.size();
         const double* fh = face_h.data() + h_base[f];
         for (size_t j = 0; j < k; ++j) {
@@ -567,6 +614,27 @@ struct PinnedLayout::Impl {
       }
     }
     return energy;
+  }
+
+  // Adds the wide faces' Hessian (into H's free rows and columns) and gradient (after the gather).
+  void add_wide(Eigen::VectorXd* g) {
+    double* hx = wide.Hx.valuePtr();
+    std::fill(hx, hx + wide.Hx.nonZeros(), 0.0);
+    wide.gx.setZero(static_cast<Eigen::Index>(wide.var.size()));
+    for (size_t w = 0; w < wide.faces.size(); ++w) {
+      for (int a = 0; a < 36; ++a) hx[wide.hx_entry[w][a]] += wide.h6[36 * w + a];
+      for (int a = 0; a < 6; ++a) wide.gx[wide.local[w][a]] += wide.g6[6 * w + a];
+    }
+    const Eigen::SparseMatrix<double> S = wide.PwT * (wide.Hx * wide.Pw);
+    if (static_cast<size_t>(S.nonZeros()) != wide.s_entry.size())
+      throw std::logic_error("PinnedLayout: the wide faces' product changed its pattern");
+    double* vals = H.valuePtr();
+    for (int c = 0; c < S.outerSize(); ++c)
+      for (int e = S.outerIndexPtr()[c]; e < S.outerIndexPtr()[c + 1]; ++e)
+        if (state[S.innerIndexPtr()[e]] == 0 && state[c] == 0) vals[wide.s_entry[e]] += S.valuePtr()[e];
+    const Eigen::VectorXd gy = wide.PwT * wide.gx;
+    for (int i = 0; i < n(); ++i)
+      if (state[i] == 0) (*g)[i] += gy[i];
   }
 
   double penalty_value(const Eigen::VectorXd& yy) const {
@@ -834,19 +902,77 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
       for (const auto& [v, a] : row) el.ys.push_back(v);
     std::sort(el.ys.begin(), el.ys.end());
     el.ys.erase(std::unique(el.ys.begin(), el.ys.end()), el.ys.end());
+    if (el.ys.size() > options.wide_face_variables) return;  // assembled through Pw (see Impl::Wide)
     el.M = Eigen::Matrix<double, 4, Eigen::Dynamic>::Zero(4, el.ys.size());
     for (int i = 0; i < 4; ++i)
       for (const auto& [v, a] : rows[i])
         el.M(i, std::lower_bound(el.ys.begin(), el.ys.end(), v) - el.ys.begin()) += a;
   });
+  // Wide faces: local numbering of their copies' coordinates, Hx's pattern (6×6 per face), Pw,
+  // and the pattern of Pwᵀ·Hx·Pw (fixed: Eigen's sparse product keeps structural zeros).
+  m.wide = Impl::Wide();
+  for (int f = 0; f < nf; ++f)
+    if (m.faces[f].ys.size() > options.wide_face_variables) {
+      m.faces[f].wide = static_cast<int>(m.wide.faces.size());
+      m.wide.faces.push_back(f);
+    }
+  Eigen::SparseMatrix<double> wide_pattern;
+  if (!m.wide.empty()) {
+    Impl::Wide& w = m.wide;
+    std::vector<int> local_of(n_vars, -1);
+    for (const int f : w.faces) {
+      std::array<int, 6> loc;
+      for (int c = 0; c < 3; ++c)
+        for (int d = 0; d < 2; ++d) {
+          const int var = 2 * m.domain.face_copies[f][c] + d;
+          if (local_of[var] < 0) {
+            local_of[var] = static_cast<int>(w.var.size());
+            w.var.push_back(var);
+          }
+          loc[2 * c + d] = local_of[var];
+        }
+      w.local.push_back(loc);
+    }
+    const int nw = static_cast<int>(w.var.size());
+    std::vector<Eigen::Triplet<double>> trip;
+    for (const auto& loc : w.local)
+      for (int a : loc)
+        for (int b : loc) trip.emplace_back(a, b, 1.0);
+    w.Hx.resize(nw, nw);
+    w.Hx.setFromTriplets(trip.begin(), trip.end());
+    w.Hx.makeCompressed();
+    for (const auto& loc : w.local) {
+      std::array<int, 36> entry;
+      for (int b = 0; b < 6; ++b)
+        for (int a = 0; a < 6; ++a) {
+          const int* begin = w.Hx.innerIndexPtr() + w.Hx.outerIndexPtr()[loc[b]];
+          const int* end = w.Hx.innerIndexPtr() + w.Hx.outerIndexPtr()[loc[b] + 1];
+          entry[a + 6 * b] = static_cast<int>(std::lower_bound(begin, end, loc[a]) - w.Hx.innerIndexPtr());
+        }
+      w.hx_entry.push_back(entry);
+    }
+    trip.clear();
+    for (int r = 0; r < nw; ++r)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(m.red.P, w.var[r]); it; ++it)
+        trip.emplace_back(r, static_cast<int>(it.col()), it.value());
+    w.Pw.resize(nw, m.n());
+    w.Pw.setFromTriplets(trip.begin(), trip.end());
+    w.Pw.makeCompressed();
+    w.PwT = w.Pw.transpose();
+    w.PwT.makeCompressed();
+    wide_pattern = w.PwT * (w.Hx * w.Pw);
+    w.g6.assign(6 * w.faces.size(), 0.0);
+    w.h6.assign(36 * w.faces.size(), 0.0);
+  }
   // The elimination can couple many unknowns in one triangle (a map with very many cones: the
-  // loops around them are solved for translations, which then chain), and the Hessian's pattern
-  // grows with the square of that (options.max_element_entries). Refused with a clear error.
+  // loops around them are solved for translations, which then chain); the narrow faces' element
+  // Hessians and the wide faces' product are stored (options.max_element_entries). Refused with
+  // a clear error above the limit.
   {
-    double entries = 0;
+    double entries = static_cast<double>(wide_pattern.nonZeros()) + 36.0 * m.wide.faces.size();
     size_t widest = 0;
     for (const Impl::Face& el : m.faces) {
-      entries += static_cast<double>(el.ys.size()) * static_cast<double>(el.ys.size());
+      if (el.wide < 0) entries += static_cast<double>(el.ys.size()) * static_cast<double>(el.ys.size());
       widest = std::max(widest, el.ys.size());
     }
     if (entries > options.max_element_entries) {
@@ -864,8 +990,12 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   std::vector<Eigen::Triplet<double>> trip;
   for (int i = 0; i < m.n(); ++i) trip.emplace_back(i, i, 0.0);
   for (const Impl::Face& el : m.faces)
-    for (int a : el.ys)
-      for (int b : el.ys) trip.emplace_back(a, b, 0.0);
+    if (el.wide < 0)
+      for (int a : el.ys)
+        for (int b : el.ys) trip.emplace_back(a, b, 0.0);
+  for (int c = 0; c < wide_pattern.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(wide_pattern, c); it; ++it)
+      trip.emplace_back(static_cast<int>(it.row()), c, 0.0);
   m.H.resize(m.n(), m.n());
   m.H.setFromTriplets(trip.begin(), trip.end());
   m.H.makeCompressed();
@@ -876,13 +1006,19 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   };
   m.diag_offset.resize(m.n());
   for (int i = 0; i < m.n(); ++i) m.diag_offset[i] = locate(i, i);
+  m.wide.s_entry.clear();
+  for (int c = 0; c < wide_pattern.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(wide_pattern, c); it; ++it)
+      m.wide.s_entry.push_back(locate(static_cast<int>(it.row()), c));
   // The flat per-face arrays and the gather lists (see Impl::h_source), in a scatter's order:
   // faces ascending, then column j, then row i.
   const int nfaces = static_cast<int>(m.faces.size());
   m.g_base.assign(nfaces + 1, 0);
   m.h_base.assign(nfaces + 1, 0);
+  // Wide faces have no entries here.
+  auto element_size = [&](int f) { return m.faces[f].wide >= 0 ? size_t{0} : m.faces[f].ys.size(); };
   for (int f = 0; f < nfaces; ++f) {
-    const size_t k = m.faces[f].ys.size();
+    const size_t k = element_size(f);
     m.g_base[f + 1] = m.g_base[f] + k;
     m.h_base[f + 1] = m.h_base[f] + k * k;
   }
@@ -894,7 +1030,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
   m.g_start.assign(static_cast<size_t>(m.n()) + 1, 0);
   for (int f = 0; f < nfaces; ++f) {
     const std::vector<int>& ys = m.faces[f].ys;
-    const size_t k = ys.size();
+    const size_t k = element_size(f);
     for (size_t j = 0; j < k; ++j)
       for (size_t i = 0; i < k; ++i) {
         const int e = locate(ys[i], ys[j]);
@@ -912,7 +1048,7 @@ core::Status PinnedLayout::init(const core::TriMesh& mesh, const CopyLayout& cop
     std::vector<size_t> g_fill(m.g_start.begin(), m.g_start.end() - 1);
     for (int f = 0; f < nfaces; ++f) {
       const std::vector<int>& ys = m.faces[f].ys;
-      const size_t k = ys.size();
+      const size_t k = element_size(f);
       for (size_t j = 0; j < k; ++j)
         for (size_t i = 0; i < k; ++i) {
           const size_t local = m.h_base[f] + i + j * k;

@@ -794,6 +794,52 @@ TEST(PinnedLayout, LimitingFacesAreAroundAMoveThatFolds) {
   EXPECT_TRUE(layout.limiting_faces({{-1, 0.0}}).empty()) << "out of range: ignored";
 }
 
+// Wide faces (more free unknowns than wide_face_variables) are assembled in the copies'
+// coordinates and mapped by the elimination: with every face wide, the same pins give the same
+// layout (up to the order of the sums), the same limiting faces and the same Newton steps.
+TEST(PinnedLayout, WideFacesThroughTheEliminationGiveTheSameSteps) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  param::CopyLayout cl;
+  ASSERT_TRUE(p.status.is_ok() && param::build_copy_layout(mesh, p.uv.corner_uv, p.seams, 1e-6, &cl).is_ok());
+  ASSERT_FALSE(p.cones.empty());
+  std::vector<char> cone_vertex(mesh.n_vertices(), 0), cone_copy(cl.n_copies(), 0);
+  for (const param::ConeInfo& c : p.cones) cone_vertex[c.vertex] = 1;
+  for (int k = 0; k < cl.n_copies(); ++k) cone_copy[k] = cone_vertex[cl.copy_vertex[k]];
+  param::PinnedLayoutOptions narrow_options, wide_options;
+  narrow_options.prefer_free = wide_options.prefer_free = cone_copy;
+  wide_options.wide_face_variables = 0;
+  param::PinnedLayout narrow, wide;
+  ASSERT_TRUE(narrow.init(mesh, cl, 10 * cl.x, narrow_options).is_ok());
+  ASSERT_TRUE(wide.init(mesh, cl, 10 * cl.x, wide_options).is_ok());
+  ASSERT_EQ(narrow.n_free(), wide.n_free());
+  // A cone coordinate half a unit away, and a copy a hundred units away (it folds its faces).
+  const std::vector<int> col_of = column_of_variable(narrow.reduction());
+  int cone_col = -1;
+  for (int k = 0; k < cl.n_copies() && cone_col < 0; ++k)
+    if (cone_copy[k] && col_of[2 * k] >= 0) cone_col = col_of[2 * k];
+  ASSERT_GE(cone_col, 0);
+  const auto [copy, j] = first_copy_with_free_u(cl, narrow);
+  ASSERT_GE(copy, 0);
+  EXPECT_EQ(narrow.limiting_faces({{j, narrow.y()[j] + 100}}), wide.limiting_faces({{j, wide.y()[j] + 100}}));
+  const std::vector<std::pair<int, double>> targets = {{cone_col, narrow.y()[cone_col] + 0.5}};
+  const param::PinReport a = narrow.pin(targets, {}, 5, 1e-6);
+  const param::PinReport b = wide.pin(targets, {}, 5, 1e-6);
+  ASSERT_TRUE(a.status.is_ok() && b.status.is_ok());
+  EXPECT_EQ(a.pinned, b.pinned);
+  EXPECT_EQ(a.pinned[0], 1);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_LT((narrow.y() - wide.y()).lpNorm<Eigen::Infinity>(), 1e-7 * narrow.y().lpNorm<Eigen::Infinity>());
+  EXPECT_EQ(wide.n_flipped(), 0);
+  core::Status st;
+  const int it_a = narrow.minimize(20, 1e-10, &st);
+  ASSERT_TRUE(st.is_ok());
+  const int it_b = wide.minimize(20, 1e-10, &st);
+  ASSERT_TRUE(st.is_ok());
+  EXPECT_NEAR(it_a, it_b, 1);
+  EXPECT_LT((narrow.y() - wide.y()).lpNorm<Eigen::Infinity>(), 1e-6 * narrow.y().lpNorm<Eigen::Infinity>());
+}
+
 TEST(ConstrainedLayout, CopiesAndAffineRowsOnTheSphere) {
   const core::TriMesh mesh = load("sphere.obj");
   const param::ParamResult p = param::compute_seamless_param(mesh);

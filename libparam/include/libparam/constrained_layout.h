@@ -163,6 +163,11 @@ struct PinnedLayoutOptions {
   // elimination (linkCup's 1,481 cones: 8.9e8, which ran out of 24 GB); spot at 5,000 quads has
   // 6.4e5.
   double max_element_entries = 4e7;
+  // A face that depends on more free variables than this is assembled in the copies' coordinates
+  // and mapped by the elimination once per evaluation (H += Pᵀ·H_x·P over those faces), instead
+  // of storing its own k×k Hessian: the faces along a seam whose translation depends on hundreds
+  // of cones share one product. Below it, per-face Hessians assembled by a gather (faster).
+  size_t wide_face_variables = 64;
 };
 
 // Outcome of PinnedLayout::pin: targets that were reached flip-free are pinned; the others stay
