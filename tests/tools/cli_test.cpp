@@ -438,6 +438,9 @@ TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
   bad_args.append("'").append(spot).append("' -o o.obj --cone-scale sometimes");
   const CliRun bad = quadify(bad_args, dir_);
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--cone-scale: 'sometimes' is neither a non-negative number nor auto"), std::string::npos)
+      << bad.err;
+  EXPECT_EQ(bad.err.find("179769"), std::string::npos) << "no DBL_MAX range: " << bad.err;
   std::string bad_pairs;
   bad_pairs.append("'").append(spot).append("' -o o.obj --surface-cone-pairs sometimes");
   const CliRun bad_pairs_run = quadify(bad_pairs, dir_);

@@ -799,12 +799,18 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
 }
 
 // An option that takes a number or "auto" (its default, shown as such in --help): `set` gets the
-// text; `check` validates it unless it is "auto".
+// text; `check` validates it unless it is "auto" (an error names `expected`, e.g. "a
+// non-negative number").
 CLI::Option* add_auto_option(CLI::App& app, const std::string& name,
                              std::function<void(const std::string&)> set, const std::string& help,
-                             const CLI::Validator& check, const std::string& type_name) {
+                             const CLI::Validator& check, const std::string& expected,
+                             const std::string& type_name) {
   return app.add_option_function<std::string>(name, std::move(set), help)
-      ->check([check](const std::string& text) { return text == "auto" ? std::string() : check(text); })
+      // The validator's own message would print its range (a non-negative number's ends at DBL_MAX).
+      ->check([check, expected](const std::string& text) {
+        if (text == "auto" || check(text).empty()) return std::string();
+        return "'" + text + "' is neither " + expected + " nor auto";
+      })
       ->default_str("auto")
       ->type_name(type_name);
 }
@@ -872,7 +878,7 @@ CommandRunner register_remesh(CLI::App& app) {
       "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
       "characteristic| a closed surface needs (its cone count is then param.fine_cones in the "
       "report), else off",
-      CLI::NonNegativeNumber, "Q|auto");
+      CLI::NonNegativeNumber, "a non-negative number", "Q|auto");
   app.add_option("--min-crease-quads", args->min_crease_quads,
                  "Leave the detected creases unaligned when every crease curve is shorter than this "
                  "many quad edges and none is a knife edge (median dihedral angle of at least 120 "
@@ -891,7 +897,7 @@ CommandRunner register_remesh(CLI::App& app) {
       "and each move tried costs a whole-mesh solve. 0 = off; auto (the default): 8 up to 60,000 "
       "input triangles, else 0. At 5,000 quads: 17 of 20 bench meshes within 0.5% of the target "
       "(without: 4), the result differing like another rounding would (Hausdorff up or down)",
-      CLI::Range(0, 1000), "N|auto");
+      CLI::Range(0, 1000), "an integer from 0 to 1000", "N|auto");
   count_adjustments->excludes(edge_length);
   app.add_option("--count-tolerance", args->count_tolerance,
                  "With --target-faces or the default density (not with --edge-length): aim the count at the target (the rounding grows the map by 2-3% on "
