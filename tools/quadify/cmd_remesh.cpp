@@ -20,6 +20,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
 
 namespace quadify::cli {
@@ -101,6 +102,15 @@ constexpr double kFarFromInput = 0.01;
 // and the thin-part retry does (octopus: 8 scales, 204 s, all dead-ending at tentacle tips).
 constexpr double kThinDeadEndSize = 0.5;
 constexpr int kThinDeadEndAttempts = 2;
+// A feature-free map below the coarse-cone density (quantize::kQuadsPerCone) whose cones still
+// dead-end at two scales stops there and is tried with coarse cones when its cones beyond the
+// topology's are more than one per this many target quads; if the coarse map fails too, the
+// first map resumes its other scales. dragon at its default density (385 cones for 18,097
+// quads): the map dead-ended at ×1.00, 1.02, 0.98, 1.04 and 0.96 of the scale and gave 28,727
+// quads at ×1.25 after 475 s of quantization; with coarse cones (231) 18,574 quads in 50 s.
+// dilo and elk (one cone per 73 and 62 quads at 5,000) dead-end once and succeed at the next
+// scale, untouched.
+constexpr double kDeadEndQuadsPerCone = 2 * quantize::kQuadsPerCone;
 
 // The same density request kRefineFactor times finer (more quads).
 void refine_density(const core::TriMesh& mesh, quantize::QuantizeOptions* options) {
@@ -363,10 +373,12 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   // used); it is parametrized in full only if the coarse maps fail.
   param_options.continue_before_tau = [&](int n_cones) { return !(coarse_cone_scale(n_cones) > 0); };
   param::ParamResult seamless = parametrize(param_options);
-  auto coarsen = [&]() {
-    const double scale = coarse_cone_scale(seamless.stats.n_cones);
+  // With dead_end (see kDeadEndQuadsPerCone), the map's cones dead-ended: coarse cones are tried
+  // whatever their density.
+  auto coarsen = [&](bool dead_end = false) {
+    const double scale = dead_end ? quantize::kCoarseConeQuadEdges * quad_edge : coarse_cone_scale(seamless.stats.n_cones);
     if (!(scale > 0)) return;
-    if (!common.quiet)
+    if (!common.quiet && !dead_end)
       std::fprintf(stderr,
                    "quadify: %s: %d cones, more than one per %.0f target quads beyond what the topology "
                    "needs: rounding the matchings on a copy smoothed at %.2g quad edges (--cone-scale 0 "
@@ -412,11 +424,31 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     if (thin.empty()) thin = param::thin_part_vertex_size(mesh, quad_edge);
     return thin;
   };
-  if (thin_retry_allowed)
-    quantize_options.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
-      if (de.attempts_without_features < kThinDeadEndAttempts || de.cone_vertex < 0) return true;
-      return !(thin_field()[de.cone_vertex] < kThinDeadEndSize);
-    };
+  // A feature-free map with cones of its own (not coarse ones, --cone-scale auto) that dead-end
+  // (see kDeadEndQuadsPerCone).
+  const core::TopologyStats topology = core::topology_stats(mesh);
+  const int topology_cones = topology.n_boundary_loops == 0 ? 4 * std::abs(topology.euler_characteristic) : 0;
+  std::vector<double> face_area(mesh.n_faces());
+  for (int f = 0; f < mesh.n_faces(); ++f) {
+    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)), p2 = mesh.V.row(mesh.F(f, 2));
+    face_area[f] = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+  }
+  const double surface = std::accumulate(face_area.begin(), face_area.end(), 0.0);
+  const double asked_quads = surface / (quad_edge * quad_edge);
+  auto coarse_retry_possible = [&]() {
+    return args.cone_scale < 0 && fine_cones < 0 && param_options.feature_edges.empty() &&
+           param_options.face_direction.empty() && seamless.stats.n_aligned_features == 0 &&
+           (seamless.stats.n_cones - topology_cones) * kDeadEndQuadsPerCone > asked_quads;
+  };
+  bool stopped_for_coarse_cones = false;
+  quantize_options.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
+    if (de.attempts_without_features < kThinDeadEndAttempts || de.cone_vertex < 0) return true;
+    if (coarse_retry_possible()) {
+      stopped_for_coarse_cones = true;
+      return false;
+    }
+    return !(thin_retry_allowed && thin_field()[de.cone_vertex] < kThinDeadEndSize);
+  };
   quantize::QuantizeResult integer_map = quantize_map(seamless);
   // A cone of index 3 or more (a quad vertex of valence 1, which the quantization refuses) in a
   // map the features shaped: without them the map gets coarse cones and cone splitting
@@ -464,6 +496,27 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     integer_map = quantize_map(seamless);
   }
   quantize_options.continue_after_dead_end = nullptr;
+  // Cones that dead-end (see kDeadEndQuadsPerCone): coarse cones, else the first map's other scales.
+  if (stopped_for_coarse_cones && integer_map.stats.stopped_at_dead_end) {
+    if (!common.quiet)
+      std::fprintf(stderr,
+                   "quadify: %s: no integer map at the first scales (%s): rounding the matchings on a "
+                   "copy smoothed at %.2g quad edges, to place fewer cones (--cone-scale 0 keeps them)\n",
+                   args.input.c_str(), integer_map.status.message().c_str(), quantize::kCoarseConeQuadEdges);
+    param::ParamResult first_map = seamless;
+    coarsen(true);
+    if (fine_cones >= 0) integer_map = quantize_map(seamless);
+    if (fine_cones < 0 || !integer_map.status.is_ok()) {
+      if (!common.quiet)
+        std::fprintf(stderr, "quadify: %s: %s; back to the first map, at its other scales\n", args.input.c_str(),
+                     fine_cones < 0 ? "no coarse cones"
+                                    : ("no integer map with coarse cones either (" + integer_map.status.message() + ")").c_str());
+      seamless = std::move(first_map);
+      fine_cones = -1;
+      report["param"] = param_json(seamless);
+      integer_map = quantize_map(seamless);
+    }
+  }
   // Thin parts: where the surface wraps a radius smaller than the quad edge (tentacles, fingers,
   // horns), the cones at their tips find no grid points, and every scale dead-ends (octopus at
   // 5,000 quads), or a tip keeps a cone of index 3 that cone splitting could not move. Without a
@@ -474,15 +527,10 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                         refused_cone(mesh, seamless, integer_map) != nullptr;
   if (dead_end && thin_retry_allowed) {
     thin_field();
-    double thin_area = 0, area = 0;
-    for (int f = 0; f < mesh.n_faces(); ++f) {
-      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
-                            p2 = mesh.V.row(mesh.F(f, 2));
-      const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm();
-      area += a;
+    double thin_area = 0;
+    for (int f = 0; f < mesh.n_faces(); ++f)
       for (int k = 0; k < 3; ++k)
-        if (thin[mesh.F(f, k)] < kThinSize) thin_area += a / 3;
-    }
+        if (thin[mesh.F(f, k)] < kThinSize) thin_area += face_area[f] / 3;
     const double smallest = thin.empty() ? 1.0 : *std::min_element(thin.begin(), thin.end());
     if (smallest < kThinSize) {
       if (!common.quiet)
@@ -490,14 +538,14 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      "quadify: %s: no integer map (%s); %.0f%% of the surface is thinner than "
                      "the quads (radius of curvature below a quad edge): parametrizing again with quads "
                      "down to %.2f times as long there\n",
-                     args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
+                     args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / surface, smallest);
       std::vector<double> sizes = thin;  // with the feature sizes, where smaller
       for (size_t v = 0; v < feature_size.size(); ++v) sizes[v] = std::min(sizes[v], feature_size[v]);
       sizing.face_size = param::face_size_from_vertices(mesh, sizes);
       sizing.report = {{"mode", feature_size.empty() ? "thin-parts" : "thin-parts+" + feature_sizing_mode},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
-                       {"thin_area_share", number(thin_area / area)}};
+                       {"thin_area_share", number(thin_area / surface)}};
       // A quantization stopped early at a thin dead end resumes its other scales if the retry
       // fails too.
       std::optional<param::ParamResult> stopped_map;
@@ -876,8 +924,8 @@ CommandRunner register_remesh(CLI::App& app) {
       "curvature details smaller than that make no cones of their own; ignored while features are "
       "aligned. 0 = off; auto (the default): 1.4, then 1.96 if that copy cannot be used, when the "
       "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
-      "characteristic| a closed surface needs (its cone count is then param.fine_cones in the "
-      "report), else off",
+      "characteristic| a closed surface needs, or more than one per 80 and they dead-end at two "
+      "scales of the rounding (its cone count is then param.fine_cones in the report), else off",
       CLI::NonNegativeNumber, "a non-negative number", "Q|auto");
   app.add_option("--min-crease-quads", args->min_crease_quads,
                  "Leave the detected creases unaligned when every crease curve is shorter than this "
