@@ -105,7 +105,7 @@ constexpr int kThinDeadEndAttempts = 2;
 // A feature-free map below the coarse-cone density (quantize::kQuadsPerCone) whose cones still
 // dead-end at two scales stops there and is tried with coarse cones when its cones beyond the
 // topology's are more than one per this many target quads; if the coarse map fails too, the
-// first map resumes its other scales. dragon at its default density (385 cones for 18,097
+// first map is quantized again at all its scales (the quantization has no resume). dragon at its default density (385 cones for 18,097
 // quads): the map dead-ended at ×1.00, 1.02, 0.98, 1.04 and 0.96 of the scale and gave 28,727
 // quads at ×1.25 after 475 s of quantization; with coarse cones (231) 18,574 quads in 50 s.
 // dilo and elk (one cone per 73 and 62 quads at 5,000) dead-end once and succeed at the next
@@ -496,7 +496,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     integer_map = quantize_map(seamless);
   }
   quantize_options.continue_after_dead_end = nullptr;
-  // Cones that dead-end (see kDeadEndQuadsPerCone): coarse cones, else the first map's other scales.
+  // Cones that dead-end (see kDeadEndQuadsPerCone): coarse cones, else the first map at all its
+  // scales.
   if (stopped_for_coarse_cones && integer_map.stats.stopped_at_dead_end) {
     if (!common.quiet)
       std::fprintf(stderr,
@@ -508,7 +509,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     if (fine_cones >= 0) integer_map = quantize_map(seamless);
     if (fine_cones < 0 || !integer_map.status.is_ok()) {
       if (!common.quiet)
-        std::fprintf(stderr, "quadify: %s: %s; back to the first map, at its other scales\n", args.input.c_str(),
+        std::fprintf(stderr, "quadify: %s: %s; back to the first map, at all its scales\n", args.input.c_str(),
                      fine_cones < 0 ? "no coarse cones"
                                     : ("no integer map with coarse cones either (" + integer_map.status.message() + ")").c_str());
       seamless = std::move(first_map);
