@@ -1433,7 +1433,8 @@ double recommended_cone_pair_distance(const core::TriMesh& mesh, const QuantizeO
   return std::max(quad_edges * target_edge_length(mesh, options), kConePairMeshEdges * mean_edge);
 }
 
-double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& options, int n_cones) {
+double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& options, int n_cones,
+                              double quads_per_cone) {
   if (mesh.n_faces() == 0) return 0;
   const double h = target_edge_length(mesh, options);
   const double target_quads = surface_area(mesh) / (h * h);
@@ -1441,7 +1442,7 @@ double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& 
   // at least 4|χ| of them (eight on a sphere), which no smoothing removes.
   const core::TopologyStats topo = core::topology_stats(mesh);
   const int needed = topo.n_boundary_loops == 0 ? 4 * std::abs(topo.euler_characteristic) : 0;
-  return (n_cones - needed) * kQuadsPerCone > target_quads ? kCoarseConeQuadEdges * h : 0;
+  return (n_cones - needed) * quads_per_cone > target_quads ? kCoarseConeQuadEdges * h : 0;
 }
 
 namespace {

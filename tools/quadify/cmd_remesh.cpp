@@ -20,7 +20,6 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <numeric>
 #include <optional>
 
 namespace quadify::cli {
@@ -426,19 +425,10 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   };
   // A feature-free map with cones of its own (not coarse ones, --cone-scale auto) that dead-end
   // (see kDeadEndQuadsPerCone).
-  const core::TopologyStats topology = core::topology_stats(mesh);
-  const int topology_cones = topology.n_boundary_loops == 0 ? 4 * std::abs(topology.euler_characteristic) : 0;
-  std::vector<double> face_area(mesh.n_faces());
-  for (int f = 0; f < mesh.n_faces(); ++f) {
-    const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)), p2 = mesh.V.row(mesh.F(f, 2));
-    face_area[f] = 0.5 * (p1 - p0).cross(p2 - p0).norm();
-  }
-  const double surface = std::accumulate(face_area.begin(), face_area.end(), 0.0);
-  const double asked_quads = surface / (quad_edge * quad_edge);
   auto coarse_retry_possible = [&]() {
     return args.cone_scale < 0 && fine_cones < 0 && param_options.feature_edges.empty() &&
            param_options.face_direction.empty() && seamless.stats.n_aligned_features == 0 &&
-           (seamless.stats.n_cones - topology_cones) * kDeadEndQuadsPerCone > asked_quads;
+           quantize::recommended_cone_scale(mesh, quantize_options, seamless.stats.n_cones, kDeadEndQuadsPerCone) > 0;
   };
   bool stopped_for_coarse_cones = false;
   quantize_options.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
@@ -528,10 +518,15 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                         refused_cone(mesh, seamless, integer_map) != nullptr;
   if (dead_end && thin_retry_allowed) {
     thin_field();
-    double thin_area = 0;
-    for (int f = 0; f < mesh.n_faces(); ++f)
+    double thin_area = 0, area = 0;
+    for (int f = 0; f < mesh.n_faces(); ++f) {
+      const Eigen::Vector3d p0 = mesh.V.row(mesh.F(f, 0)), p1 = mesh.V.row(mesh.F(f, 1)),
+                            p2 = mesh.V.row(mesh.F(f, 2));
+      const double a = 0.5 * (p1 - p0).cross(p2 - p0).norm();
+      area += a;
       for (int k = 0; k < 3; ++k)
-        if (thin[mesh.F(f, k)] < kThinSize) thin_area += face_area[f] / 3;
+        if (thin[mesh.F(f, k)] < kThinSize) thin_area += a / 3;
+    }
     const double smallest = thin.empty() ? 1.0 : *std::min_element(thin.begin(), thin.end());
     if (smallest < kThinSize) {
       if (!common.quiet)
@@ -539,14 +534,14 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                      "quadify: %s: no integer map (%s); %.0f%% of the surface is thinner than "
                      "the quads (radius of curvature below a quad edge): parametrizing again with quads "
                      "down to %.2f times as long there\n",
-                     args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / surface, smallest);
+                     args.input.c_str(), integer_map.status.message().c_str(), 100 * thin_area / area, smallest);
       std::vector<double> sizes = thin;  // with the feature sizes, where smaller
       for (size_t v = 0; v < feature_size.size(); ++v) sizes[v] = std::min(sizes[v], feature_size[v]);
       sizing.face_size = param::face_size_from_vertices(mesh, sizes);
       sizing.report = {{"mode", feature_size.empty() ? "thin-parts" : "thin-parts+" + feature_sizing_mode},
                        {"reason", integer_map.status.message()},
                        {"min", number(smallest)},
-                       {"thin_area_share", number(thin_area / surface)}};
+                       {"thin_area_share", number(thin_area / area)}};
       // A quantization stopped early at a thin dead end resumes its other scales if the retry
       // fails too.
       std::optional<param::ParamResult> stopped_map;

@@ -196,7 +196,7 @@ inline constexpr int kRecommendedConePairHops = 6;
 
 // The param::ParamOptions::cone_scale that suits quantization at `options`' density, for a
 // feature-free map with n_cones cones: 0 (the paper's map as it is) while the cones beyond the
-// 4|χ| a closed surface needs are at most one per kQuadsPerCone target quads, else
+// 4|χ| a closed surface needs are at most one per quads_per_cone (kQuadsPerCone) target quads, else
 // kCoarseConeQuadEdges target quad edge lengths
 // (the matchings rounded on a smoothed copy). Measured at 5,000 quads: maps with one cone per
 // 28 quads or more (mannequin-devil 177, dragon about 380) dead-end in the rounding, where the
@@ -204,7 +204,7 @@ inline constexpr int kRecommendedConePairHops = 6;
 inline constexpr double kQuadsPerCone = 40;
 inline constexpr double kCoarseConeQuadEdges = 1.4;
 [[nodiscard]] double recommended_cone_scale(const core::TriMesh& mesh, const QuantizeOptions& options,
-                                            int n_cones);
+                                            int n_cones, double quads_per_cone = kQuadsPerCone);
 
 // The feature edges (vertex-id pairs of `mesh`) that quantization at `options`' density can keep
 // on integer iso-lines: a feature curve (a connected component of the feature edges) shorter
