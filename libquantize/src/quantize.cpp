@@ -106,6 +106,11 @@ constexpr int kGridRing = 1;
 constexpr int kFarPenaltyStages = 8;
 // Other grid points tried, one at a time, for a cone whose batch could not move it.
 constexpr size_t kConeAlternatives = 4;
+// Backtracking at a cone that reaches none of them (Rounder::unstick_cone): the pinned cones of
+// its chart within this many grid units (max norm) are freed, at most kUnstickCones of them,
+// nearest first, and rounded again together with it.
+constexpr double kUnstickRadius = 2;
+constexpr size_t kUnstickCones = 4;
 // Floor of recommended_cone_pair_distance, in mean edge lengths of the input.
 constexpr double kConePairMeshEdges = 8;
 // Scales tried with the aligned features before they are dropped: the target and the first two
@@ -663,6 +668,10 @@ class Rounder {
         placed = layout_.is_pinned(c.col_u) && layout_.is_pinned(c.col_v);
       }
       if (!placed) {
+        if (const Outcome o = unstick_cone(i, &placed); o != Outcome::kDone) return o;
+        if (placed) continue;
+      }
+      if (!placed) {
         const Eigen::Vector2d p = position(c);
         stuck_on_cones_ = true;
         stuck_cone_vertex_ = cl_.copy_vertex[c.copy];
@@ -680,6 +689,64 @@ class Rounder {
       occupied_[key(c, layout_.y()[c.col_u], layout_.y()[c.col_v])] = cl_.copy_vertex[c.copy];
       report_progress("cones");
     }
+    return Outcome::kDone;
+  }
+
+  // Backtracking (ours): cone i reached no free grid point. The pinned cones of its chart within
+  // kUnstickRadius grid units (at most kUnstickCones, nearest first) are freed and rounded again
+  // together with it as a cluster (distinct grid points by distance, the penalty homotopy); their
+  // grid points and the room between them are what blocks it, when another cone took the point it
+  // needed first. If that fails too, the layout, the grid and the dead end's record are restored
+  // exactly (PinnedLayout::restore) and *placed stays false. Not nested.
+  Outcome unstick_cone(int i, bool* placed) {
+    *placed = false;
+    if (unsticking_) return Outcome::kDone;
+    const Cone& c = cones_[i];
+    const Eigen::Vector2d p = position(c);
+    std::vector<std::pair<double, int>> near;
+    for (int o = 0; o < static_cast<int>(cones_.size()); ++o) {
+      const Cone& n = cones_[o];
+      if (o == i || cl_.copy_component[n.copy] != cl_.copy_component[c.copy] ||
+          cl_.copy_vertex[n.copy] == cl_.copy_vertex[c.copy] || !layout_.is_pinned(n.col_u) ||
+          !layout_.is_pinned(n.col_v))
+        continue;
+      const double d = (position(n) - p).lpNorm<Eigen::Infinity>();
+      if (d <= kUnstickRadius) near.push_back({d, o});
+    }
+    if (near.empty()) return Outcome::kDone;
+    std::sort(near.begin(), near.end());
+    if (near.size() > kUnstickCones) near.resize(kUnstickCones);
+    const param::PinnedLayout::Saved saved = layout_.saved();
+    const std::map<GridKey, int> occupied = occupied_;
+    const std::vector<int> stuck_faces = stuck_faces_;
+    const std::string stuck = stuck_;
+    const bool stuck_on_cones = stuck_on_cones_;
+    const int stuck_cone_vertex = stuck_cone_vertex_, n_pinned = n_pinned_;
+    std::vector<int> batch = {i};
+    for (const auto& [d, o] : near) {
+      const Cone& n = cones_[o];
+      occupied_.erase(key(n, layout_.y()[n.col_u], layout_.y()[n.col_v]));
+      layout_.unpin(n.col_u);
+      layout_.unpin(n.col_v);
+      n_pinned_ -= 2;
+      batch.push_back(o);
+    }
+    unsticking_ = true;
+    const Outcome o = round_cone_batch(batch, true);
+    unsticking_ = false;
+    if (o == Outcome::kDone) {
+      ++stats_->n_unstuck_cones;
+      *placed = true;
+      return o;
+    }
+    if (o != Outcome::kStuck) return o;
+    layout_.restore(saved);
+    occupied_ = occupied;
+    stuck_faces_ = stuck_faces;
+    n_pinned_ = n_pinned;
+    stuck_ = stuck;
+    stuck_on_cones_ = stuck_on_cones;
+    stuck_cone_vertex_ = stuck_cone_vertex;
     return Outcome::kDone;
   }
 
@@ -866,6 +933,7 @@ class Rounder {
   bool stuck_on_cones_ = false;
   int stuck_cone_vertex_ = -1;
   std::vector<int> stuck_faces_;
+  bool unsticking_ = false;  // inside unstick_cone
 };
 
 // Whether a is a multiple of 2^-kMaxDenominatorBits (exactly).

@@ -524,7 +524,7 @@ TEST(QuantizeSeamless, TimeBudgetStopsWithAMessage) {
 // grid points, so the attempts dead-end; continue_after_dead_end sees each dead end before the
 // next scale (the cone and the faces in the way) and can stop the quantization there.
 TEST(QuantizeSeamless, CallerCanStopAtADeadEnd) {
-  const core::TriMesh mesh = load("sphere.obj");
+  const core::TriMesh mesh = load("torus.obj");
   const param::ParamResult p = param::compute_seamless_param(mesh);
   ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
   quantize::QuantizeOptions qo;
@@ -555,6 +555,33 @@ TEST(QuantizeSeamless, CallerCanStopAtADeadEnd) {
   EXPECT_EQ(seen[0].scale, 1.0);
   EXPECT_NE(seen[1].scale, 1.0) << "the next attempt is at another scale";
   EXPECT_NE(seen[2].scale, seen[1].scale);
+}
+
+// The sphere's map (14 cones) asked into two quads: whichever cones are pinned first take the
+// grid points the others need, and without backtracking all eight attempts (the target's scale,
+// its jitters, then ×1.25 twice) dead-ended, as at four quads (checked on 2026-12-07). Freeing the
+// pinned neighbours of a blocked cone and rounding them again with it gets through: 14 cones on
+// 14 distinct grid points, at least 12 quads on a sphere.
+TEST(QuantizeSeamless, ConesBlockedByTheirNeighboursAreRoundedAgainWithThem) {
+  const core::TriMesh mesh = load("sphere.obj");
+  const param::ParamResult p = param::compute_seamless_param(mesh);
+  ASSERT_TRUE(p.status.is_ok()) << p.status.to_string();
+  quantize::QuantizeOptions qo;
+  qo.target_faces = 2;
+  const quantize::QuantizeResult q = quantize::quantize_seamless(mesh, p, qo);
+  ASSERT_TRUE(q.status.is_ok()) << q.status.to_string();
+  EXPECT_GT(q.stats.n_unstuck_cones, 0) << "the test no longer reaches a blocked cone";
+  EXPECT_EQ(q.stats.n_flipped, 0);
+  EXPECT_EQ(q.stats.n_rounded, q.stats.n_candidates);
+  EXPECT_EQ(test::integer_seamless_violation(q.uv), "");
+  const quadex::ExtractResult ex = quadex::extract_quads(q.uv);
+  ASSERT_TRUE(ex.status.is_ok()) << ex.status.to_string();
+  const quadex::QuadMetrics qm = quadex::compute_quad_metrics(ex.quads);
+  EXPECT_GE(qm.n_faces, p.stats.n_cones - 2);
+  EXPECT_LE(qm.n_faces, 2 * p.stats.n_cones) << "far more quads than asked";
+  EXPECT_EQ(qm.n_non_quads, 0);
+  EXPECT_TRUE(qm.manifold);
+  EXPECT_EQ(qm.euler_characteristic, 2);
 }
 
 TEST(QuantizeSeamless, ProgressReportsRoundedUnknownsAndScale) {

@@ -334,6 +334,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
         {"features_dropped_reason", features_dropped ? features_dropped_reason : qs.features_dropped_reason},
         {"clustered_cones", qs.n_clustered_cones},
         {"cone_collisions", qs.n_cone_collisions},
+        {"unstuck_cones", qs.n_unstuck_cones},
         {"newton_iterations", qs.n_iterations},
         {"seconds_setup", qs.seconds_setup},
         {"seconds_rounding", qs.seconds_rounding},

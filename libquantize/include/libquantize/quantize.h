@@ -160,6 +160,7 @@ struct QuantizeStats {
   bool out_of_time = false;
   int n_cone_collisions = 0;  // cones that their batch could not move to the chosen grid point
   int n_clustered_cones = 0;  // cones rounded jointly because another cone was within 1.5 units
+  int n_unstuck_cones = 0;    // cones that reached a grid point only with their neighbours rounded again
   int n_iterations = 0;       // Newton iterations (one factorization each) in total
   double uv_area = 0;         // UV area of the result (≈ number of quads)
   double uv_area_unadjusted = 0;  // of QuantizeResult::uv_unadjusted, when it is kept
