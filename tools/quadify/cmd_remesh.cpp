@@ -101,14 +101,14 @@ constexpr double kFarFromInput = 0.01;
 // and the thin-part retry does (octopus: 8 scales, 204 s, all dead-ending at tentacle tips).
 constexpr double kThinDeadEndSize = 0.5;
 constexpr int kThinDeadEndAttempts = 2;
-// A feature-free map below the coarse-cone density (quantize::kQuadsPerCone) whose cones still
-// dead-end at two scales stops there and is tried with coarse cones when its cones beyond the
+// A feature-free map below the coarse-cone density (quantize::kQuadsPerCone) whose rounding still
+// dead-ends at two scales (on a cone, or on a translation once the cones are placed) stops there and is tried with coarse cones when its cones beyond the
 // topology's are more than one per this many target quads; if the coarse map fails too, the
 // first map is quantized again at all its scales (the quantization has no resume). dragon at its default density (385 cones for 18,097
 // quads): the map dead-ended at ×1.00, 1.02, 0.98, 1.04 and 0.96 of the scale and gave 28,727
 // quads at ×1.25 after 475 s of quantization; with coarse cones (231) 18,574 quads in 50 s.
-// dilo and elk (one cone per 73 and 62 quads at 5,000) dead-end once and succeed at the next
-// scale, untouched.
+// elk (one cone per 62 quads at 5,000) dead-ends once and succeeds at the next scale, untouched
+// (dilo, one per 73, did so before the backtracking at blocked cones).
 constexpr double kDeadEndQuadsPerCone = 2 * quantize::kQuadsPerCone;
 
 // The same density request kRefineFactor times finer (more quads).
@@ -433,11 +433,15 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   };
   bool stopped_for_coarse_cones = false;
   quantize_options.continue_after_dead_end = [&](const quantize::DeadEnd& de) {
-    if (de.attempts_without_features < kThinDeadEndAttempts || de.cone_vertex < 0) return true;
+    if (de.attempts_without_features < kThinDeadEndAttempts) return true;
+    // On a cone or a translation: with the backtracking at blocked cones, a map with too many
+    // cones for the grid places them and then dead-ends on the translations between them
+    // (dragon at its default density, at every scale).
     if (coarse_retry_possible()) {
       stopped_for_coarse_cones = true;
       return false;
     }
+    if (de.cone_vertex < 0) return true;
     return !(thin_retry_allowed && thin_field()[de.cone_vertex] < kThinDeadEndSize);
   };
   quantize::QuantizeResult integer_map = quantize_map(seamless);
@@ -921,7 +925,7 @@ CommandRunner register_remesh(CLI::App& app) {
       "curvature details smaller than that make no cones of their own; ignored while features are "
       "aligned. 0 = off; auto (the default): 1.4, then 1.96 if that copy cannot be used, when the "
       "feature-free map has more than one cone per 40 target quads beyond the 4|Euler "
-      "characteristic| a closed surface needs, or more than one per 80 and they dead-end at two "
+      "characteristic| a closed surface needs, or more than one per 80 and its rounding dead-ends at two "
       "scales of the rounding (its cone count is then param.fine_cones in the report), else off",
       CLI::NonNegativeNumber, "a non-negative number", "Q|auto");
   app.add_option("--min-crease-quads", args->min_crease_quads,
