@@ -102,9 +102,10 @@ constexpr double kFarFromInput = 0.01;
 constexpr double kThinDeadEndSize = 0.5;
 constexpr int kThinDeadEndAttempts = 2;
 // A feature-free map below the coarse-cone density (quantize::kQuadsPerCone) whose rounding still
-// dead-ends at two scales (on a cone, or on a translation once the cones are placed) stops there and is tried with coarse cones when its cones beyond the
-// topology's are more than one per this many target quads; if the coarse map fails too, the
-// first map is quantized again at all its scales (the quantization has no resume). dragon at its default density (385 cones for 18,097
+// dead-ends at two scales (on a cone, or on a translation once the cones are placed) stops there
+// and is tried with coarse cones when its cones beyond the topology's are more than one per this
+// many target quads; if the coarse map fails too, the first map is quantized again at all its
+// scales (the quantization has no resume). dragon at its default density (385 cones for 18,097
 // quads): the map dead-ended at ×1.00, 1.02, 0.98, 1.04 and 0.96 of the scale and gave 28,727
 // quads at ×1.25 after 475 s of quantization; with coarse cones (231) 18,574 quads in 50 s.
 // elk (one cone per 62 quads at 5,000) dead-ends once and succeeds at the next scale, untouched
