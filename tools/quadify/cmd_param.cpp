@@ -171,7 +171,7 @@ CommandRunner register_param(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--surface-cone-pairs", o.cone_pair_surface,
                "With --cone-pair-distance: then also remove the pairs within that distance over the surface "
-               "whose seam path is longer, along that seam path, where the map's tau grows by at most 5% and no "
+               "whose seam path is longer, along that seam path, where the map's tau grows by at most 25% and no "
                "face's size by more than 1.75 times");
   app.add_option("--cone-split-distance", o.cone_split_distance,
                  "Split every cone of index above --cone-split-max-index (a quad vertex of valence 1 or 2, made "

@@ -900,10 +900,10 @@ CommandRunner register_remesh(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--surface-cone-pairs", args->surface_cone_pairs,
                  "Also cancel the cone pairs within --cone-pair-distance over the surface whose seam path is "
-                 "long (the cut joins near vertices by long seam paths), where the map's tau grows by at most 5% "
+                 "long (the cut joins near vertices by long seam paths), where the map's tau grows by at most 25% "
                  "and no face's size by more than 1.75 times: on, off (only pairs joined by a short seam path), "
                  "auto (the default: on up to 60,000 input triangles; each set costs a whole-mesh solve). "
-                 "knot1 at 5,000 quads: 26 -> 14 irregular vertices")
+                 "knot1 at 5,000 quads: 26 -> 10 irregular vertices")
       ->check(CLI::IsMember({"on", "off", "auto"}))
       ->capture_default_str();
   app.add_option("--cone-split-distance", args->cone_split_distance,

@@ -67,8 +67,8 @@ struct ParamOptions {
   // along that seam path, however long (the map is the one a cut along the surface path would give,
   // up to a rotation of the charts between the two paths; a dual-spanning-tree cut joins
   // neighbouring vertices by seam paths 2-9 times longer than the surface's: knot1). Off the
-  // aligned features' vertices; a set is kept when it raises the map's τ at that stage by at most
-  // 5% and changes no face's singular values by more than 1.75 times (else it goes again without
+  // aligned features' vertices; a set is kept when the map's τ at that stage stays within 1.25
+  // times its τ before the surface pairs and it changes no face's singular values by more than 1.75 times (else it goes again without
   // the pairs nearest to the faces beyond that). Not on the smoothed copy of cone_scale, nor on a
   // map continue_before_tau rejects. Without the size bound, over 20 meshes at 5,000
   // quads: irregular vertices 903 → 711, but Hausdorff higher on 12 (spot 0.0037 → 0.0057,
