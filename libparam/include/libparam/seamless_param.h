@@ -68,8 +68,9 @@ struct ParamOptions {
   // up to a rotation of the charts between the two paths; a dual-spanning-tree cut joins
   // neighbouring vertices by seam paths 2-9 times longer than the surface's: knot1). Off the
   // aligned features' vertices; a set is kept when the map's τ at that stage stays within 1.25
-  // times its τ before the surface pairs and it changes no face's singular values by more than 1.75 times (else it goes again without
-  // the pairs nearest to the faces beyond that). Not on the smoothed copy of cone_scale, nor on a
+  // times its τ before the surface pairs and it changes no face's singular values by more than
+  // 1.75 times (else it goes again without the pairs nearest to the faces beyond that; a pair
+  // that failed on its own is not tried again). Not on the smoothed copy of cone_scale, nor on a
   // map continue_before_tau rejects. Without the size bound, over 20 meshes at 5,000
   // quads: irregular vertices 903 → 711, but Hausdorff higher on 12 (spot 0.0037 → 0.0057,
   // mannequin-devil 0.0089 → 0.0174: a protrusion shrunk); see the README.
