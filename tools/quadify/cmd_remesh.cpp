@@ -86,8 +86,10 @@ constexpr double kFeatureCornerQuadEdges = 2;
 constexpr int kSurfacePairMaxFaces = 60'000;
 // --count-adjustments auto: this many moves for inputs of at most kCountAdjustMaxFaces triangles
 // (with a count asked for), else none. Each move tried is a whole-mesh solve (about 1.4 s at 100K
-// triangles): feline's three moves cost 16 s of its 80 s budget (issue 5).
-constexpr int kAutoCountAdjustments = 8;
+// triangles): feline's three moves cost 16 s of its 80 s budget (issue 5). 16 since 2026-12-07
+// (8 before): of the 20-mesh regression at 5,000 quads only wingnut used all 8, and with 16 it
+// takes 14: 5,080 → 5,035 quads, Hausdorff 0.0040 → 0.0031, capture 0.960 → 0.965.
+constexpr int kAutoCountAdjustments = 16;
 constexpr int kCountAdjustMaxFaces = 60'000;
 // The count adjustment's quads are kept unless their Hausdorff distance to the input exceeds that
 // of the quads before it by this factor, or exceeds kFarFromInput where theirs does not (see the
@@ -944,7 +946,7 @@ CommandRunner register_remesh(CLI::App& app) {
       "unit each while the quad count is more than 0.5% off the target, where a move brings it "
       "closer, keeping a move only if the map stays flip-free and its distortion energy grows by at "
       "most the share of the target it gains (and 1%); the count is known exactly before a move, "
-      "and each move tried costs a whole-mesh solve. 0 = off; auto (the default): 8 up to 60,000 "
+      "and each move tried costs a whole-mesh solve. 0 = off; auto (the default): 16 up to 60,000 "
       "input triangles, else 0. At 5,000 quads: 18 of 20 bench meshes within 0.5% of the target "
       "(without: 4), the result differing like another rounding would (Hausdorff up or down)",
       CLI::Range(0, 1000), "an integer from 0 to 1000", "N|auto");
