@@ -235,7 +235,14 @@ FeatureInput collect_feature_edges(const FeatureArgs& args, const std::string& i
 }  // namespace
 
 void warn_feature_fallbacks(const std::string& input, const param::ParamStats& stats, bool quiet) {
-  if (quiet || stats.n_feature_fallbacks == 0) return;
+  if (quiet) return;
+  if (stats.n_feature_partial_fallbacks > 0)
+    std::fprintf(stderr,
+                 "quadify: %s: %d of %d components could not be parametrized flip-free with all their "
+                 "features and were parametrized without those near where they failed (%s)\n",
+                 input.c_str(), stats.n_feature_partial_fallbacks, stats.n_components,
+                 stats.feature_fallback_reason.c_str());
+  if (stats.n_feature_fallbacks == 0) return;
   std::fprintf(stderr,
                "quadify: %s: %d of %d components could not be parametrized flip-free with their "
                "features and were parametrized without them (%s)\n",
@@ -288,6 +295,7 @@ nlohmann::json feature_json(const FeatureInput& fi, const param::ParamStats& s) 
           {"disabled_by_flips", s.n_disabled_by_flips},
           {"patches", s.n_feature_patches},
           {"components_without_features", s.n_feature_fallbacks},
+          {"components_without_features_near_failure", s.n_feature_partial_fallbacks},
           {"fallback_reason", s.feature_fallback_reason},
           {"alignment_error", number(s.feature_alignment_error)}};
 }

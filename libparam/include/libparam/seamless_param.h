@@ -216,7 +216,11 @@ struct ParamStats {
   int n_feature_patches = 0;   // local-estimation patches laid out for feature labels
   int n_feature_fallbacks = 0; // components that failed with their features and were
                                // parametrized again without them (all counted as disabled)
-  std::string feature_fallback_reason;  // why the first of them failed ("" if none did)
+  int n_feature_partial_fallbacks = 0;  // components that failed with their features and were
+                                       // parametrized again without those within 2 vertex rings
+                                       // of the faces their last batch left flipped (those
+                                       // counted as disabled by flips)
+  std::string feature_fallback_reason;  // why the first failed run of either failed ("" if none)
   double feature_alignment_error = 0;  // max |Δ constant coordinate| / |edge| over aligned ones
   int n_direction_faces = 0;   // faces with a direction to align (ParamOptions::face_direction)
   // Area-weighted mean angle (degrees, 0..45) between those directions' images and the nearest
