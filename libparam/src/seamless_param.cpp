@@ -546,12 +546,17 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // Still flipped without this batch's features: the features of earlier batches hold the
     // layout there. Those near the faces left flipped are disabled and the batch is redone, then,
     // if that is not enough, without any feature (rather than failing the component, which would
-    // then be parametrized again from the start without its features: crank's 11,610 creases).
+    // then be parametrized again from the start without its features: crank's 11,610 creases) —
+    // after the deferral of the batch's seams near the flips, where one can follow (since
+    // 2026-12-07: `quadify param plane_holes.obj` dropped all its 1,282 feature edges first, and
+    // the deferral then left no face flipped, a map without features; now the deferral leaves
+    // one, the component fails, and its run without the features near the failure keeps 930).
     std::vector<char> in_batch(fs.size(), 0);
     for (const int i : fbatch) in_batch[i] = 1;
-    for (int pass = 0; pass < 2 && !feature_rows.empty() && (!tr.status.is_ok() || tr.n_flipped > 0);
-         ++pass) {
-      const std::vector<char> near = pass == 0 ? near_flips() : std::vector<char>(mesh.n_vertices(), 1);
+    auto still_flipped = [&] { return !tr.status.is_ok() || tr.n_flipped > 0; };
+    auto drop_earlier_features = [&](bool all) {
+      if (feature_rows.empty() || !still_flipped()) return;
+      const std::vector<char> near = all ? std::vector<char>(mesh.n_vertices(), 1) : near_flips();
       int n_dropped = 0;
       for (int i = 0; i < fs.size(); ++i) {
         int& l = in_batch[i] ? proposed[i] : label[i];
@@ -561,7 +566,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
           ++n_dropped;
         }
       }
-      if (n_dropped == 0) continue;
+      if (n_dropped == 0) return;
       feature_rows.clear();
       for (int i = 0; i < fs.size(); ++i)
         if (!in_batch[i] && (label[i] == 0 || label[i] == 1))
@@ -570,7 +575,11 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       for (const SparseRow& row : feature_rows) elim.add_row(row);
       elim_without_features.reset();
       redo_batch();
-    }
+    };
+    drop_earlier_features(false);
+    // Every earlier feature goes only after the deferral below, where one can follow.
+    const bool can_defer = tr.n_flipped > 0 && (!last || extra_steps < kMaxDeferredBatches);
+    if (!can_defer) drop_earlier_features(true);
     // Still flipped: the batch's seams near the flipped faces (two vertex rings) wait for the
     // next batch, measured again on the layout re-optimized with the others rounded, where they
     // avoid the integer they had; the last batch is repeated for them at most
@@ -608,6 +617,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         redo_batch();
       }
     }
+    if (can_defer) drop_earlier_features(true);
     mark_trouble();
     for (const int i : fbatch) label[i] = proposed[i];
     feature_rows.insert(feature_rows.end(), batch_feature_rows.begin(), batch_feature_rows.end());
