@@ -78,6 +78,17 @@ struct ComponentOutput {
   std::vector<char> trouble_faces;
 };
 
+// Grows the vertex set *near by `rings` rings of faces.
+void grow_vertex_rings(const core::TriMesh& mesh, int rings, std::vector<char>* near) {
+  for (int ring = 0; ring < rings; ++ring) {
+    std::vector<char> grown = *near;
+    for (int f = 0; f < mesh.n_faces(); ++f)
+      if ((*near)[mesh.F(f, 0)] || (*near)[mesh.F(f, 1)] || (*near)[mesh.F(f, 2)])
+        grown[mesh.F(f, 0)] = grown[mesh.F(f, 1)] = grown[mesh.F(f, 2)] = 1;
+    near->swap(grown);
+  }
+}
+
 void add_timers(const OptimizeTimers& t, ParamStats* s) {
   s->seconds_setup += t.setup;
   s->seconds_assembly += t.assembly;
@@ -478,13 +489,7 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
         for (int f = 0; f < mesh.n_faces(); ++f)
           if (is_sliver(f))
             for (int k = 0; k < 3; ++k) near[mesh.F(f, k)] = 1;
-      for (int ring = 0; ring < 2; ++ring) {
-        std::vector<char> grown = near;
-        for (int f = 0; f < mesh.n_faces(); ++f)
-          if (near[mesh.F(f, 0)] || near[mesh.F(f, 1)] || near[mesh.F(f, 2)])
-            grown[mesh.F(f, 0)] = grown[mesh.F(f, 1)] = grown[mesh.F(f, 2)] = 1;
-        near.swap(grown);
-      }
+      grow_vertex_rings(mesh, 2, &near);
       return near;
     };
     auto near_feature = [&](const std::vector<char>& near, int i) {
@@ -553,9 +558,8 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
     // one, the component fails, and its run without the features near the failure keeps 930).
     std::vector<char> in_batch(fs.size(), 0);
     for (const int i : fbatch) in_batch[i] = 1;
-    auto still_flipped = [&] { return !tr.status.is_ok() || tr.n_flipped > 0; };
     auto drop_earlier_features = [&](bool all) {
-      if (feature_rows.empty() || !still_flipped()) return;
+      if (feature_rows.empty() || (tr.status.is_ok() && tr.n_flipped == 0)) return;
       const std::vector<char> near = all ? std::vector<char>(mesh.n_vertices(), 1) : near_flips();
       int n_dropped = 0;
       for (int i = 0; i < fs.size(); ++i) {
@@ -1270,23 +1274,16 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
   // its features count as disabled.
   ParamOptions plain_options = component_options;
   plain_options.align_boundaries = false;
-  // The retry without the features near the faces the failed run left flipped: its boundary
-  // edges (with align_boundaries) are given as features, so that those near them go too.
-  ParamOptions near_trouble_options = component_options;
-  near_trouble_options.align_boundaries = false;
+  // The features of the retry without those near the faces the failed run left flipped (with
+  // plain_options: its boundary edges, with align_boundaries, are given as features, so that
+  // those near them go too).
   auto features_away_from = [&](int c, const std::vector<char>& trouble) {
     const core::TriMesh& m = sub[c];
     std::vector<char> near(m.n_vertices(), 0);
     for (int f = 0; f < m.n_faces(); ++f)
       if (trouble[f])
         for (int k = 0; k < 3; ++k) near[m.F(f, k)] = 1;
-    for (int ring = 0; ring < kTroubleRings; ++ring) {
-      std::vector<char> grown = near;
-      for (int f = 0; f < m.n_faces(); ++f)
-        if (near[m.F(f, 0)] || near[m.F(f, 1)] || near[m.F(f, 2)])
-          grown[m.F(f, 0)] = grown[m.F(f, 1)] = grown[m.F(f, 2)] = 1;
-      near.swap(grown);
-    }
+    grow_vertex_rings(m, kTroubleRings, &near);
     std::vector<std::array<int, 2>> edges = sub_features[c];
     if (component_options.align_boundaries) {
       const core::EdgeTopology topo = core::build_edge_topology(m);
@@ -1308,7 +1305,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     // First again without the features near the faces its last batch left flipped (the fallback
     // below drops them all).
     if (!outs[c].trouble_faces.empty()) {
-      ComponentOutput retry = run_component(sub[c], near_trouble_options, features_away_from(c, outs[c].trouble_faces),
+      ComponentOutput retry = run_component(sub[c], plain_options, features_away_from(c, outs[c].trouble_faces),
                                             sub_size[c], sub_metric[c], sub_direction[c]);
       if (retry.status.is_ok()) {
         retry.stats.n_disabled_features += n_features - retry.stats.n_feature_edges;

@@ -45,12 +45,6 @@ class CliSlow : public ::testing::Test {
   fs::path meshes_, dir_;
 };
 
-// fandisk at 5,000 quads: the largest distance to the surface sits at a crease corner that a row
-// of quads cuts off (a crease edge left unaligned by the wedge check); the snap that meets it
-// folds a quad, which the repair then opens again, and the tentative snap keeps it
-// (RelaxOptions::tentative_snaps). Measured: 0.0031 → 0.0019 of the diagonal with the cone pairs
-// of b13687e; with the feature-sector check of the cone pairs and the label flips along their
-// paths (a map with 3 more pairs cancelled, 32 irregular vertices instead of 38), 0.0037 → 0.0020.
 // plane_holes at 5,000 quads: its parametrization fails with its 1,282 feature and boundary
 // edges (its last batch leaves faces flipped on the tail fin and a wing's knife edge); run again
 // without the features near there, it keeps most of them, and the grid no longer cuts most of
@@ -88,6 +82,12 @@ TEST_F(CliSlow, PlaneHolesParamKeepsMostOfItsFeatures) {
   EXPECT_EQ(report["param"]["flipped"], 0);
 }
 
+// fandisk at 5,000 quads: the largest distance to the surface sits at a crease corner that a row
+// of quads cuts off (a crease edge left unaligned by the wedge check); the snap that meets it
+// folds a quad, which the repair then opens again, and the tentative snap keeps it
+// (RelaxOptions::tentative_snaps). Measured: 0.0031 → 0.0019 of the diagonal with the cone pairs
+// of b13687e; with the feature-sector check of the cone pairs and the label flips along their
+// paths (a map with 3 more pairs cancelled, 32 irregular vertices instead of 38), 0.0037 → 0.0020.
 TEST_F(CliSlow, FandiskCreaseCornerIsMetByATentativeSnap) {
   if (!has("fandisk.obj")) GTEST_SKIP() << "no fandisk";
   const nlohmann::json report = remesh("fandisk.obj");
