@@ -331,6 +331,27 @@ TEST_F(CliTest, RemeshWritesManifoldPureQuadMesh) {
   EXPECT_EQ(r.out.find("feature capture"), std::string::npos) << r.out;
 }
 
+// A boundary the quads do not follow (the disk with --no-boundary-alignment) cuts the grid into
+// pentagons and triangles; by default they become quads (midpoints on boundary edges or along
+// paths of faces, merges, splits), and the outline and distance stay; --no-pure-quads keeps them.
+TEST_F(CliTest, RemeshMakesPureQuadsWhereTheGridMeetsAnUnalignedBoundary) {
+  const fs::path disk = data_path("disk.obj");
+  const nlohmann::json kept = remesh_report(disk, 300, "--no-boundary-alignment --no-pure-quads");
+  const nlohmann::json pure = remesh_report(disk, 300, "--no-boundary-alignment");
+  EXPECT_GT(kept["quads"]["non_quads"].get<int>(), 10);
+  EXPECT_FALSE(kept.contains("pure_quads"));
+  EXPECT_EQ(pure["quads"]["non_quads"], 0);
+  EXPECT_EQ(pure["pure_quads"]["non_quads_before"], kept["quads"]["non_quads"]);
+  EXPECT_EQ(pure["pure_quads"]["non_quads_after"], 0);
+  EXPECT_EQ(pure["quads"]["flipped_quads"], 0);
+  EXPECT_EQ(pure["quads"]["manifold"], true);
+  EXPECT_EQ(pure["quads"]["genus"], 0);
+  EXPECT_GT(pure["quads"]["sj_min"].get<double>(), 0.1);
+  EXPECT_LE(pure["quads"]["hausdorff_sym"].get<double>(), kept["quads"]["hausdorff_sym"].get<double>() * 1.05);
+  EXPECT_NEAR(pure["quads"]["faces"].get<int>(), kept["quads"]["faces"].get<int>(),
+              0.2 * kept["quads"]["faces"].get<int>());
+}
+
 // The summary names the feature capture where features were aligned, and a result farther from
 // the input than 1% of its diagonal gets a warning that says what helps (the washer at 150 quads:
 // about 1.5%); --quiet prints neither.

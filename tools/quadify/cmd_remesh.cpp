@@ -9,6 +9,7 @@
 #include <libparam/sizing.h>
 #include <libquadex/extract_quads.h>
 #include <libquadex/quad_metrics.h>
+#include <libquadex/pure_quads.h>
 #include <libquadex/relax_quads.h>
 #include <libquadex/small_components.h>
 #include <libquantize/quantize.h>
@@ -34,6 +35,7 @@ struct RemeshArgs {
   std::string map_output;  // the integer-seamless triangle map as a UV OBJ ("" = none)
   bool measure = true;
   bool relax = true;
+  bool pure_quads = true;
   bool feature_snap = true;
   bool tentative_snaps = true;
   bool fit = true;
@@ -683,7 +685,16 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                    small.stats.n_faces_removed, left_out_note.c_str());
     }
   }
-  auto relax = [&](quadex::ExtractResult* quads) {
+  // Faces that are not quads (where the grid meets a boundary the map does not follow) become
+  // quads, before the relaxation that smooths the split.
+  auto relax = [&](quadex::ExtractResult* quads, quadex::PureQuadStats* pure_stats) {
+    if (args.pure_quads) {
+      quadex::PureQuadResult pure = quadex::make_pure_quads(quads->quads);
+      if (!pure.status.is_ok())
+        throw CliError{kExitInternal, args.input + ": pure quads: " + pure.status.to_string()};
+      quads->quads = std::move(pure.quads);
+      *pure_stats = pure.stats;
+    }
     quadex::RelaxStats stats;
     if (!args.relax) return stats;
     progress.begin("relax");
@@ -699,7 +710,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     quads->quads = std::move(relaxed.quads);
     return relaxed.stats;
   };
-  quadex::RelaxStats relax_stats = relax(&extracted);
+  quadex::PureQuadStats pure_stats;
+  quadex::RelaxStats relax_stats = relax(&extracted, &pure_stats);
   // The count adjustment moves the map like another rounding would, and the quads' distance to
   // the input with it: its quads are kept unless they are farther from the input than those of
   // the map before it by more than kAdjustedDistanceGrowth, or beyond kFarFromInput where those are
@@ -725,7 +737,8 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       quadex::SmallComponentResult plain_small = split_small(plain_map, plain);
       if (plain_small.stats.n_replaced == small.stats.n_replaced) {
         if (plain_small.stats.n_replaced > 0) plain.quads = std::move(plain_small.quads);
-        const quadex::RelaxStats plain_relax = relax(&plain);
+        quadex::PureQuadStats plain_pure;
+        const quadex::RelaxStats plain_relax = relax(&plain, &plain_pure);
         progress.begin("measure");
         const quadex::QuadMetrics pm = quadex::compute_quad_metrics(plain.quads, &mesh, metric_options);
         progress.end();
@@ -741,6 +754,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
           integer_map = std::move(plain_map);
           extracted = std::move(plain);
           relax_stats = plain_relax;
+          pure_stats = plain_pure;
           kept_metrics = pm;
           adjustment_undone = true;
         }
@@ -773,6 +787,21 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
   report["small_components"] = {{"replaced", small.stats.n_replaced},
                                  {"faces_removed", small.stats.n_faces_removed},
                                  {"quads_added", small.stats.n_quads_added}};
+  if (args.pure_quads)
+    report["pure_quads"] = {{"non_quads_before", pure_stats.n_non_quads_before},
+                            {"non_quads_after", pure_stats.n_non_quads_after},
+                            {"edges_collapsed", pure_stats.n_edges_collapsed},
+                            {"vertices_removed", pure_stats.n_vertices_removed},
+                            {"boundary_splits", pure_stats.n_boundary_splits},
+                            {"paths", pure_stats.n_paths},
+                            {"edges_split", pure_stats.n_edges_split},
+                            {"centers", pure_stats.n_centers},
+                            {"midpoints_shifted", pure_stats.n_midpoints_shifted},
+                            {"doublets_removed", pure_stats.n_doublets_removed},
+                            {"merged", pure_stats.n_merged},
+                            {"faces_split", pure_stats.n_faces_split},
+                            {"quads_added", pure_stats.n_quads_added},
+                            {"worst_quality", pure_stats.worst_quality}};
   if (args.relax)
     report["relax"] = {{"bad_before", relax_stats.n_bad_before},
                        {"bad_after", relax_stats.n_bad_after},
@@ -989,6 +1018,11 @@ CommandRunner register_remesh(CLI::App& app) {
   app.add_flag("!--no-relax", args->relax,
                "Keep the extracted vertex positions (by default, vertices of quads with a corner of "
                "scaled Jacobian below 0.2 are relaxed on the input surface)");
+  app.add_flag("!--no-pure-quads", args->pure_quads,
+               "Keep the faces that are not quads where the quad grid meets a boundary it does not "
+               "follow (by default each odd face gets a vertex at the midpoint of its longest boundary "
+               "edge, or of the edges along a path of faces to the nearest other odd face or boundary, "
+               "and every face is then split into quads; see pure_quads in the report)");
   app.add_flag("!--no-feature-snap", args->feature_snap,
                "Do not move quad vertices onto a nearby feature curve that their quads cut off (by "
                "default, part of the relaxation; see relax.snapped in the report)");
