@@ -1,17 +1,27 @@
 // Pure quads from a quad-dominant mesh. Where the extraction meets a boundary that the map does
 // not follow (a feature the parametrization had to give up), the grid is cut into polygons that
-// are not quads: a pentagon or triangle where a boundary cuts a quad's corner off. Each face of
-// odd degree first loses a nearly flat corner on the boundary where it has one (a vertex where a
-// grid line crossed a straight stretch of boundary), else gets one more vertex: a face on the boundary at the midpoint of its longest boundary
-// edge, any other face along a path of faces to the nearest other odd face (or face on the
-// boundary), with a midpoint on every edge the path crosses. Then every face has an even number of
-// vertices and is split into quads: along diagonals (the split whose worst corner is best), or,
-// where no split has a good worst corner (a path turning inside a quad), around a new vertex at
-// its centroid. Quads untouched by all this stay as they are.
+// are not quads: a pentagon or triangle where a boundary cuts a quad's corner off. In order:
+//  1. an edge of such a polygon shorter than a quarter of the mean edge length, with an end on
+//     the boundary, is collapsed onto that end (a sliver where the boundary passes a grid point);
+//  2. a polygon of more than 4 corners loses its nearly flat corners that no other face has
+//     (turn ≤ 15° between two boundary edges), down to 4 or an even degree;
+//  3. two faces of odd degree side by side merge (their shared edge goes);
+//  4. an odd face of degree ≥ 5 on the boundary gets a midpoint on the boundary edge whose split
+//     is best, if that split has no flat corner;
+//  5. any other odd face is joined by a path of faces to the nearest other odd face (merged if
+//     adjacent) or face on the boundary (which gets a boundary midpoint), a midpoint on every
+//     edge the path crosses (faces whose split keeps its corners off flat first);
+//  6. every face now has an even number of vertices and is split into quads: along diagonals
+//     (the split whose worst corner is best), or, where that worst corner is poor (a path
+//     turning inside a quad), around a new vertex at its centroid;
+//  7. an inner midpoint left as a flat corner (a triangle's) moves 0.3 of the way to its spokes'
+//     far ends, and a vertex inside the surface left with two quads (a doublet) goes.
+// Quads untouched by all this stay as they are.
 //
 // Invariants: the result's faces are all quads where every odd face found a partner within
-// max_path_faces; the boundary keeps its shape (boundary midpoints lie on boundary edges); an
-// edge-manifold, consistently oriented input stays so; deterministic.
+// max_path_faces; the boundary keeps its vertices' positions (new ones lie on boundary edges;
+// a collapse moves an inner vertex onto the boundary); an edge-manifold, consistently oriented
+// input stays so (a collapse or merge that would break it is not made); deterministic.
 #pragma once
 
 #include <libcore/mesh.h>
