@@ -140,7 +140,7 @@ core::PolyMesh collapse_short_boundary_edges(const core::PolyMesh& mesh, std::ve
       faces[f].push_back(mesh.vertex(f, k));
       if (uv) faces_uv[f].push_back(mesh.face_uv[mesh.face_corner(f, k)]);
     }
-  Eigen::MatrixX3d V = mesh.V;
+  const Eigen::MatrixX3d& V = mesh.V;
   auto edge_counts = [&] {
     std::unordered_map<std::uint64_t, int> n;
     for (int f = 0; f < nf; ++f)
@@ -221,13 +221,11 @@ core::PolyMesh collapse_short_boundary_edges(const core::PolyMesh& mesh, std::ve
     faces_uv = std::move(new_uv);
     *proper = std::move(new_proper);
     count = new_count;
-    V.row(a) = on_boundary[a] ? V.row(a) : V.row(b);  // the boundary end's position
-    on_boundary[a] = on_boundary[a] || on_boundary[b];
-    gone[b] = 1;
+    gone[b] = 1;  // a, on the boundary, keeps its position; b's faces now have a
     ++*n_collapsed;
   }
   core::PolyMesh out;
-  out.V = V;
+  out.V = mesh.V;
   out.uv = mesh.uv;
   out.lines = mesh.lines;
   std::vector<char> kept_proper;
@@ -691,7 +689,7 @@ void split_faces(const core::PolyMesh& mesh, const std::vector<char>& proper, co
   for (int v = 0; v < static_cast<int>(positions.size()); ++v) {
     if (vertex_faces[v].size() != 2) continue;
     const int f = vertex_faces[v][0], g = vertex_faces[v][1];
-    if (!is_created[f] && !is_created[g]) continue;
+    if (f == g || (!is_created[f] && !is_created[g])) continue;
     if (faces[f].size() != 4 || faces[g].size() != 4) continue;
     const int kf = static_cast<int>(std::find(faces[f].begin(), faces[f].end(), v) - faces[f].begin());
     const int kg = static_cast<int>(std::find(faces[g].begin(), faces[g].end(), v) - faces[g].begin());
