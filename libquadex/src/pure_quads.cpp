@@ -246,10 +246,10 @@ double turn_degrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Ei
   return std::acos(std::clamp(u.dot(w) / l, -1.0, 1.0)) * 180 / 3.14159265358979323846;
 }
 
-// The faces of `mesh` without their removable boundary vertices (see kMaxRemovedTurn): in a face
-// of degree above 4 (proper), up to degree - 4 of them, flattest first, an even number fewer
-// where that leaves an odd degree... precisely: the greedy removals r are cut to r - 1 when
-// degree - r would be odd. Vertices keep their ids (the removed ones become unreferenced).
+// The faces of `mesh` without their removable boundary vertices (see kMaxRemovedTurn): in a proper
+// face of degree above 4, flattest first, while it has more than 4 corners; the last removal is
+// undone when the count r of removals leaves an odd degree (an even polygon splits along a
+// diagonal). Vertices keep their ids (the removed ones become unreferenced).
 core::PolyMesh remove_flat_boundary_vertices(const core::PolyMesh& mesh, const std::vector<char>& proper,
                                              int* n_removed) {
   const int nf = mesh.n_faces();
@@ -278,7 +278,6 @@ core::PolyMesh remove_flat_boundary_vertices(const core::PolyMesh& mesh, const s
     }
     if (proper[f] && d > 4) {
       // Greedy: the flattest removable vertex of the current polygon, while above 4 corners.
-      std::vector<std::array<int, 3>> removed;  // (vertex, its uv row, position) in order
       std::vector<std::vector<int>> states = {poly}, uv_states = {poly_uv};
       while (static_cast<int>(poly.size()) > 4) {
         const int n = static_cast<int>(poly.size());
@@ -304,7 +303,7 @@ core::PolyMesh remove_flat_boundary_vertices(const core::PolyMesh& mesh, const s
         states.push_back(poly);
         uv_states.push_back(poly_uv);
       }
-      // An odd result keeps the last removed vertex (an even polygon splits along a diagonal).
+      // An odd result keeps the last removed vertex.
       int r = static_cast<int>(states.size()) - 1;
       if (r > 0 && (d - r) % 2 == 1) {
         const std::vector<int>& prev = states[r - 1];
@@ -364,7 +363,6 @@ void split_faces(const core::PolyMesh& mesh, const std::vector<char>& proper, co
   }
   auto is_boundary = [&](int e) { return edge_faces[e].size() == 1 && !blocked[e]; };
   auto crossable = [&](int e) { return edge_faces[e].size() == 2 && !blocked[e]; };
-  // (merged_edge, below, also stops paths: see crossing)
   auto edge_length = [&](int e) { return (mesh.V.row(edge_vertices[e][0]) - mesh.V.row(edge_vertices[e][1])).norm(); };
   // The face's longest boundary edge (-1: none).
   auto longest_boundary_edge = [&](int f) {
@@ -713,13 +711,12 @@ void split_faces(const core::PolyMesh& mesh, const std::vector<char>& proper, co
   if (res.stats.n_doublets_removed > 0) {
     core::PolyMesh kept;
     kept.lines = out.lines;
+    created.clear();
     for (size_t f = 0; f < faces.size(); ++f)
       if (!faces[f].empty()) {
-        if (is_created[f]) created.push_back(-1 - kept.n_faces());  // marked, re-listed below
+        if (is_created[f]) created.push_back(kept.n_faces());
         kept.add_face(faces[f], faces_uv[f]);
       }
-    created.erase(std::remove_if(created.begin(), created.end(), [](int f) { return f >= 0; }), created.end());
-    for (int& f : created) f = -1 - f;
     out = std::move(kept);
     res.stats.n_quads_added -= res.stats.n_doublets_removed;
   }
@@ -738,9 +735,8 @@ void split_faces(const core::PolyMesh& mesh, const std::vector<char>& proper, co
 
 }  // namespace
 
-PureQuadResult make_pure_quads(const core::PolyMesh& input, const PureQuadOptions& options) {
+PureQuadResult make_pure_quads(const core::PolyMesh& mesh, const PureQuadOptions& options) {
   PureQuadResult res;
-  const core::PolyMesh& mesh = input;
   const int nf = mesh.n_faces(), nv = mesh.n_vertices();
   if (options.max_path_faces < 0 || !(options.min_diagonal_quality <= 1)) {
     res.status = core::Status::invalid_input("make_pure_quads: max_path_faces < 0 or min_diagonal_quality > 1");
@@ -774,10 +770,10 @@ PureQuadResult make_pure_quads(const core::PolyMesh& input, const PureQuadOption
   }
   res.quads = mesh;
   if (res.stats.n_non_quads_before == 0) return res;
-  const core::PolyMesh collapsed = collapse_short_boundary_edges(input, &proper, &res.stats.n_edges_collapsed);
+  const core::PolyMesh collapsed = collapse_short_boundary_edges(mesh, &proper, &res.stats.n_edges_collapsed);
   const core::PolyMesh reduced = remove_flat_boundary_vertices(collapsed, proper, &res.stats.n_vertices_removed);
   split_faces(reduced, proper, options, &res);
-  // The removed vertices go (the others keep their order).
+  // Unreferenced vertices (the collapsed and removed ones) go; the others keep their order.
   std::vector<int> new_id(res.quads.n_vertices(), -1);
   for (const int v : res.quads.face_vertex) new_id[v] = 0;
   int n_kept = 0;

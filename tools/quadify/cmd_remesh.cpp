@@ -685,9 +685,9 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
                    small.stats.n_faces_removed, left_out_note.c_str());
     }
   }
-  // Faces that are not quads (where the grid meets a boundary the map does not follow) become
-  // quads, before the relaxation that smooths the split.
-  auto relax = [&](quadex::ExtractResult* quads, quadex::PureQuadStats* pure_stats) {
+  // The extracted quads finished: faces that are not quads (where the grid meets a boundary the
+  // map does not follow) become quads, then the relaxation smooths them and the rest.
+  auto finish_quads = [&](quadex::ExtractResult* quads, quadex::PureQuadStats* pure_stats) {
     if (args.pure_quads) {
       quadex::PureQuadResult pure = quadex::make_pure_quads(quads->quads);
       if (!pure.status.is_ok())
@@ -711,7 +711,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
     return relaxed.stats;
   };
   quadex::PureQuadStats pure_stats;
-  quadex::RelaxStats relax_stats = relax(&extracted, &pure_stats);
+  quadex::RelaxStats relax_stats = finish_quads(&extracted, &pure_stats);
   // The count adjustment moves the map like another rounding would, and the quads' distance to
   // the input with it: its quads are kept unless they are farther from the input than those of
   // the map before it by more than kAdjustedDistanceGrowth, or beyond kFarFromInput where those are
@@ -738,7 +738,7 @@ int remesh_stages(const RemeshArgs& args, const CommonOptions& common, LoadedMes
       if (plain_small.stats.n_replaced == small.stats.n_replaced) {
         if (plain_small.stats.n_replaced > 0) plain.quads = std::move(plain_small.quads);
         quadex::PureQuadStats plain_pure;
-        const quadex::RelaxStats plain_relax = relax(&plain, &plain_pure);
+        const quadex::RelaxStats plain_relax = finish_quads(&plain, &plain_pure);
         progress.begin("measure");
         const quadex::QuadMetrics pm = quadex::compute_quad_metrics(plain.quads, &mesh, metric_options);
         progress.end();
@@ -1020,9 +1020,10 @@ CommandRunner register_remesh(CLI::App& app) {
                "scaled Jacobian below 0.2 are relaxed on the input surface)");
   app.add_flag("!--no-pure-quads", args->pure_quads,
                "Keep the faces that are not quads where the quad grid meets a boundary it does not "
-               "follow (by default each odd face gets a vertex at the midpoint of its longest boundary "
-               "edge, or of the edges along a path of faces to the nearest other odd face or boundary, "
-               "and every face is then split into quads; see pure_quads in the report)");
+               "follow (by default a face of odd degree loses a sliver's short edge or a flat boundary "
+               "corner, merges with an odd neighbour, or gets a midpoint on a boundary edge or on the "
+               "edges along a path of faces to the nearest other odd face or boundary, and every face "
+               "is then split into quads; see pure_quads in the report)");
   app.add_flag("!--no-feature-snap", args->feature_snap,
                "Do not move quad vertices onto a nearby feature curve that their quads cut off (by "
                "default, part of the relaxation; see relax.snapped in the report)");

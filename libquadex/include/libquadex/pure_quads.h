@@ -73,9 +73,11 @@ struct PureQuadResult {
   PureQuadStats stats;
 };
 
-// Unchanged (a copy) when every face is a quad. Removed vertices go, the others keep their order,
-// new vertices come after them (lines are renumbered with them; a line at a removed vertex goes). When `mesh` carries UVs, the new corners get UVs interpolated from their face's corners. Faces with fewer
-// than 3 or repeated vertices, and edges with more than two faces, are left alone.
+// Unchanged (a copy) when every face is a quad. Otherwise unreferenced vertices (the collapsed
+// and removed ones) go, the others keep their order, and new vertices come after them (lines are
+// renumbered with them; a line at a vertex that went goes). When `mesh` carries UVs, the new
+// corners get UVs interpolated from their face's corners. Faces with fewer than 3 or repeated
+// vertices, and edges with more than two faces, are left alone.
 // Returns kInvalidInput for vertex ids out of range or bad options.
 [[nodiscard]] PureQuadResult make_pure_quads(const core::PolyMesh& mesh, const PureQuadOptions& options = {});
 
