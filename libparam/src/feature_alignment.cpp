@@ -248,6 +248,73 @@ std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const
   return split;
 }
 
+std::vector<FeatureCurve> curves_at_acute_corners(const core::TriMesh& mesh, const FeatureSet& fs,
+                                                  const std::vector<FeatureCurve>& curves,
+                                                  double min_angle, double max_angle,
+                                                  double max_bend) {
+  std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());  // (feature, other end)
+  for (int i = 0; i < fs.size(); ++i) {
+    const auto [a, b] = feature_vertices(mesh, fs, i);
+    at[a].push_back({i, b});
+    at[b].push_back({i, a});
+  }
+  auto direction = [&](int from, int to) {
+    return (Eigen::Vector3d(mesh.V.row(to)) - Eigen::Vector3d(mesh.V.row(from))).normalized();
+  };
+  auto angle = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::acos(std::clamp(a.dot(b), -1.0, 1.0));
+  };
+  std::vector<int> curve_of(fs.size(), -1);
+  for (size_t c = 0; c < curves.size(); ++c)
+    for (const int i : curves[c].features) curve_of[i] = static_cast<int>(c);
+  std::vector<FeatureCurve> out;
+  for (size_t c = 0; c < curves.size(); ++c) {
+    const FeatureCurve& curve = curves[c];
+    if (curve.closed || curve.joints.size() + 1 != curve.features.size()) continue;
+    // The curve's vertices in order: its first end, the joints, its last end.
+    const size_t n = curve.features.size();
+    std::vector<int> path(n + 1);
+    const auto first = feature_vertices(mesh, fs, curve.features.front());
+    const auto last = feature_vertices(mesh, fs, curve.features.back());
+    path.front() = n == 1 ? first[0] : (first[0] == curve.joints.front() ? first[1] : first[0]);
+    path.back() = n == 1 ? first[1] : (last[0] == curve.joints.back() ? last[1] : last[0]);
+    for (size_t k = 0; k + 1 < n; ++k) path[k + 1] = curve.joints[k];
+    // Edges [lo, hi) of the curve to take: the straight run from each acute end.
+    size_t lo = n, hi = 0;
+    for (const bool at_front : {true, false}) {
+      const int v = at_front ? path.front() : path.back();
+      const int next = at_front ? path[1] : path[n - 1];
+      const Eigen::Vector3d d = direction(v, next);
+      bool acute = false;
+      for (const auto& [j, other] : at[v]) {
+        const double a = angle(d, direction(v, other));
+        if (curve_of[j] != static_cast<int>(c) && a >= min_angle && a < max_angle) acute = true;
+      }
+      if (!acute) continue;
+      size_t k = 1;  // edges of the run
+      while (k < n) {
+        const size_t e = at_front ? k : n - 1 - k;  // edge e joins path[e] and path[e + 1]
+        const Eigen::Vector3d de = at_front ? direction(path[e], path[e + 1]) : direction(path[e + 1], path[e]);
+        if (angle(d, de) >= max_bend) break;
+        ++k;
+      }
+      if (at_front) {
+        lo = 0;
+        hi = std::max(hi, k);
+      } else {
+        lo = std::min(lo, n - k);
+        hi = n;
+      }
+    }
+    if (hi < lo + 2) continue;  // nothing acute, or a single edge (labeled edge by edge anyway)
+    FeatureCurve run;
+    run.features.assign(curve.features.begin() + lo, curve.features.begin() + hi);
+    run.joints.assign(curve.joints.begin() + lo, curve.joints.begin() + hi - 1);
+    out.push_back(std::move(run));
+  }
+  return out;
+}
+
 std::vector<double> curve_turns(const core::TriMesh& mesh, const CutMesh& cut, const Eigen::VectorXd& x,
                                 const FeatureSet& fs, const FeatureCurve& curve) {
   const auto& topo = cut.topo;

@@ -60,6 +60,17 @@ std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const
                                                 double max_bend, double corner_length = 0,
                                                 double corner_turn = std::numbers::pi / 3);
 
+// The straight runs of the open curves of `curves` from their ends at acute corners: an end
+// where another feature leaves at an angle in [min_angle, max_angle) (radians, on the surface) to
+// the curve's end edge. A run is the curve's edges from that end while their direction stays
+// within max_bend of the end edge's (on the surface; a curve bending into a rounded rim further on
+// keeps its rim out), two edges at least; a curve acute at both ends gives the part from the start
+// of one run to the end of the other. In the order of `curves`.
+std::vector<FeatureCurve> curves_at_acute_corners(const core::TriMesh& mesh, const FeatureSet& fs,
+                                                  const std::vector<FeatureCurve>& curves,
+                                                  double min_angle, double max_angle,
+                                                  double max_bend);
+
 // Turn (radians, counter-clockwise positive) of each feature of a curve from the direction of its
 // first feature, followed along the curve in the layout x (corner angles summed around each
 // joint, so seams in between do not matter); the first is 0. NaN after a joint on a boundary

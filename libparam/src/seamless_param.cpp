@@ -65,6 +65,12 @@ constexpr double kFeatureBlameGrowth = 1.1;
 // opposite directions).
 constexpr double kCurveMaxBend = std::numbers::pi / 6;
 constexpr double kCurveMaxTurn = std::numbers::pi / 3;
+// Acute corners (ParamOptions::feature_acute_curve_labels): angles between two creases at a
+// vertex, on the surface (radians).
+constexpr double kAcuteCornerMin = std::numbers::pi / 12, kAcuteCornerMax = std::numbers::pi / 4;
+// ... and the straight run of such a curve labeled whole: its edges within this of the direction
+// of its edge at the corner, on the surface (radians).
+constexpr double kAcuteRunBend = std::numbers::pi / 4;
 
 struct ComponentOutput {
   core::Status status;
@@ -235,8 +241,15 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   std::vector<SparseRow> feature_rows;  // rows of the labeled features, in labeling order
   // Smooth curves of two features or more, labeled as one (feature_curve_labels).
   std::vector<FeatureCurve> curves;
-  if (options.feature_curve_labels && options.feature_mode == FeatureMode::kDuringRounding)
-    curves = smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length);
+  if (options.feature_mode == FeatureMode::kDuringRounding) {
+    if (options.feature_curve_labels)
+      curves = smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length);
+    else if (options.feature_acute_curve_labels && fs.size() > 0)
+      curves = curves_at_acute_corners(
+          mesh, fs, smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length),
+          kAcuteCornerMin, kAcuteCornerMax, kAcuteRunBend);
+    out.stats.n_acute_curves = options.feature_curve_labels ? 0 : static_cast<int>(curves.size());
+  }
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
 
@@ -1359,6 +1372,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_disabled_by_wedge += o.stats.n_disabled_by_wedge;
     st.n_disabled_by_flips += o.stats.n_disabled_by_flips;
     st.n_feature_patches += o.stats.n_feature_patches;
+    st.n_acute_curves += o.stats.n_acute_curves;
     st.feature_alignment_error = std::max(st.feature_alignment_error, o.stats.feature_alignment_error);
     st.n_direction_faces += o.stats.n_direction_faces;
     st.n_seam_edges += o.stats.n_seam_edges;

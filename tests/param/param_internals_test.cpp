@@ -725,6 +725,55 @@ TEST(FeatureAlignment, SmoothCurvesAndTheirTurnsInTheLayout) {
   EXPECT_EQ(tighter[0].features.size(), 24u);
 }
 
+// Three spokes of a paraboloid disk (24 sectors, 4 rings) as features: spokes 0 and 2 leave the
+// centre 29° apart on the surface (an acute corner), spoke 8 at 88° and 116° from them. Each
+// spoke bends upwards by 20°, 14° and 10° at its joints (43° from its first edge to its last).
+TEST(FeatureAlignment, CurvesAtAcuteCornersAreTheirStraightRuns) {
+  const core::TriMesh mesh = test::make_disk(4, 24);
+  const CutMesh cut = cut_along_dual_tree(mesh, 0);
+  auto spoke_vertex = [](int j, int ring) { return ring == 0 ? 0 : 1 + (ring - 1) * 24 + j; };
+  std::vector<int> edges;
+  for (const int j : {0, 2, 8})
+    for (int ring = 0; ring < 4; ++ring)
+      for (int e = 0; e < cut.topo.n_edges(); ++e) {
+        const int a = cut.topo.edge_vertex(e, 0), b = cut.topo.edge_vertex(e, 1);
+        const int p = spoke_vertex(j, ring), q = spoke_vertex(j, ring + 1);
+        if ((a == p && b == q) || (a == q && b == p)) edges.push_back(e);
+      }
+  ASSERT_EQ(edges.size(), 12u);
+  const FeatureSet fs = make_feature_set(cut, edges);
+  const std::vector<FeatureCurve> curves = smooth_feature_curves(mesh, fs, std::numbers::pi / 6);
+  ASSERT_EQ(curves.size(), 3u);
+  const double deg = std::numbers::pi / 180;
+  auto touches_centre = [&](const FeatureCurve& c) {
+    for (const int i : c.features) {
+      const int h = fs.halfedge[i];
+      if (mesh.F(h / 3, h % 3) == 0 || mesh.F(h / 3, (h % 3 + 1) % 3) == 0) return true;
+    }
+    return false;
+  };
+  // Within 45° of their first edge, the two acute spokes are straight runs of all their edges.
+  const std::vector<FeatureCurve> whole = curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 45 * deg);
+  ASSERT_EQ(whole.size(), 2u);
+  for (const FeatureCurve& c : whole) {
+    EXPECT_EQ(c.features.size(), 4u);
+    EXPECT_EQ(c.joints.size(), 3u);
+    EXPECT_TRUE(touches_centre(c));
+  }
+  // Within 30°, their runs end after the second edge (34° from the first); the runs start at
+  // the centre.
+  const std::vector<FeatureCurve> runs = curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 30 * deg);
+  ASSERT_EQ(runs.size(), 2u);
+  for (const FeatureCurve& c : runs) {
+    EXPECT_EQ(c.features.size(), 2u);
+    EXPECT_EQ(c.joints.size(), 1u);
+    EXPECT_TRUE(touches_centre(c));
+  }
+  // 29° is not acute for a lower bound of 30°, and spoke 8 never is.
+  EXPECT_TRUE(curves_at_acute_corners(mesh, fs, curves, 30 * deg, 45 * deg, 45 * deg).empty());
+  EXPECT_EQ(curves_at_acute_corners(mesh, fs, curves, 15 * deg, 100 * deg, 45 * deg).size(), 3u);
+}
+
 // A rounded square (sides of four unit edges, corners rounded by three edges of 0.2 turning
 // 22.5° at each of four joints), fanned from its centre: its boundary is one smooth loop. With a
 // corner length of one unit, each rounded corner (90° within 0.6) splits it, at the middle of the

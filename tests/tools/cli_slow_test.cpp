@@ -84,6 +84,35 @@ TEST_F(CliSlow, PlaneHolesParamKeepsMostOfItsFeatures) {
   EXPECT_EQ(report["param"]["flipped"], 0);
 }
 
+// `quadify param fandisk.obj`: two creases meet at 22° at a wedge's tip. Labeled edge by edge
+// (the paper's Alg. 2), both take one axis near the tip, whose edges the wedge check disables,
+// and the wedge becomes a strip between two parallel iso-lines, squeezed where it is wide: τ 2.91.
+// Labeled as whole curves (the default of `param`), the wedge opens to a quarter turn at its tip:
+// τ 2.05.
+TEST_F(CliSlow, FandiskAcuteWedgeOpensToAQuarterTurn) {
+  if (!has("fandisk.obj")) GTEST_SKIP() << "no fandisk";
+  auto param = [&](const std::string& extra) -> nlohmann::json {
+    std::string args = "param '";
+    args.append((meshes_ / "fandisk.obj").string()).append("' -o '").append((dir_ / "p.obj").string());
+    args.append("' --quiet --json '").append((dir_ / "p.json").string()).append("' ").append(extra);
+    const CliRun r = quadify(args, dir_);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    if (r.exit_code != 0) return nullptr;
+    return nlohmann::json::parse(slurp(dir_ / "p.json"));
+  };
+  const nlohmann::json on = param("");
+  ASSERT_FALSE(on.is_null());
+  EXPECT_EQ(on["param"]["features"]["acute_curves"], 2);
+  EXPECT_EQ(on["param"]["flipped"], 0);
+  const nlohmann::json off = param("--acute-curve-labels off");
+  ASSERT_FALSE(off.is_null());
+  EXPECT_EQ(off["param"]["features"]["acute_curves"], 0);
+  EXPECT_EQ(off["param"]["flipped"], 0);
+  EXPECT_LT(on["param"]["tau"].get<double>(), 2.3);
+  EXPECT_GT(off["param"]["tau"].get<double>(), 2.6);
+  EXPECT_GE(on["param"]["features"]["aligned"].get<int>(), off["param"]["features"]["aligned"].get<int>() - 5);
+}
+
 // fandisk at 5,000 quads: the largest distance to the surface sits at a crease corner that a row
 // of quads cuts off (a crease edge left unaligned by the wedge check); the snap that meets it
 // folds a quad, which the repair then opens again, and the tentative snap keeps it

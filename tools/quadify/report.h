@@ -92,6 +92,7 @@ struct FeatureArgs {
   double max_tau = 2.5;      // --feature-max-tau
   double max_wedge_stretch = 1.95;  // --feature-max-wedge-stretch
   bool curve_labels = false;  // --feature-curve-labels: smooth feature curves labeled as one
+  bool acute_curve_labels = true;  // --acute-curve-labels on|off (the remesher: off by default)
   bool soft = false;         // --feature-mode after: Alg. 3 (param::FeatureMode::kAfterRounding)
 };
 void add_feature_options(CLI::App& app, FeatureArgs* args);
@@ -111,6 +112,7 @@ struct FeatureInput {
   int n_wedges_flipped = 0;  // core::flip_feature_wedges on the repaired mesh
   bool soft = false;    // Alg. 3 (--feature-mode after)
   bool curve_labels = false;  // --feature-curve-labels
+  bool acute_curve_labels = true;  // --acute-curve-labels
 };
 // Also flips the feature wedges of loaded->repaired.mesh (core::flip_feature_wedges: faces
 // change, vertex ids stay).
