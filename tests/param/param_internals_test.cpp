@@ -752,23 +752,19 @@ TEST(FeatureAlignment, CurvesAtAcuteCornersAreTheirStraightRuns) {
     }
     return false;
   };
-  // Within 45° of their first edge, the two acute spokes are straight runs of all their edges.
-  const std::vector<FeatureCurve> whole = curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 45 * deg);
-  ASSERT_EQ(whole.size(), 2u);
-  for (const FeatureCurve& c : whole) {
-    EXPECT_EQ(c.features.size(), 4u);
-    EXPECT_EQ(c.joints.size(), 3u);
-    EXPECT_TRUE(touches_centre(c));
-  }
-  // Within 30°, their runs end after the second edge (34° from the first); the runs start at
-  // the centre.
-  const std::vector<FeatureCurve> runs = curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 30 * deg);
-  ASSERT_EQ(runs.size(), 2u);
-  for (const FeatureCurve& c : runs) {
-    EXPECT_EQ(c.features.size(), 2u);
-    EXPECT_EQ(c.joints.size(), 1u);
-    EXPECT_TRUE(touches_centre(c));
-  }
+  // Two runs (the acute spokes) of `edges` edges each, starting at the centre.
+  auto expect_runs = [&](const std::vector<FeatureCurve>& runs, size_t edges) {
+    ASSERT_EQ(runs.size(), 2u);
+    for (const FeatureCurve& c : runs) {
+      EXPECT_EQ(c.features.size(), edges);
+      EXPECT_EQ(c.joints.size(), edges - 1);
+      EXPECT_TRUE(touches_centre(c));
+    }
+  };
+  // Within 45° of their first edge, the two acute spokes are straight runs of all their edges;
+  // within 30°, their runs end after the second edge (34° from the first).
+  expect_runs(curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 45 * deg), 4);
+  expect_runs(curves_at_acute_corners(mesh, fs, curves, 15 * deg, 45 * deg, 30 * deg), 2);
   // 29° is not acute for a lower bound of 30°, and spoke 8 never is.
   EXPECT_TRUE(curves_at_acute_corners(mesh, fs, curves, 30 * deg, 45 * deg, 45 * deg).empty());
   EXPECT_EQ(curves_at_acute_corners(mesh, fs, curves, 15 * deg, 100 * deg, 45 * deg).size(), 3u);
