@@ -83,6 +83,18 @@ std::array<int, 2> feature_vertices(const core::TriMesh& mesh, const FeatureSet&
   return {mesh.F(h / 3, h % 3), mesh.F(h / 3, (h % 3 + 1) % 3)};
 }
 
+// The features at each vertex, with the other end of their edge.
+std::vector<std::vector<std::pair<int, int>>> features_at_vertices(const core::TriMesh& mesh,
+                                                                   const FeatureSet& fs) {
+  std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());
+  for (int i = 0; i < fs.size(); ++i) {
+    const auto [a, b] = feature_vertices(mesh, fs, i);
+    at[a].push_back({i, b});
+    at[b].push_back({i, a});
+  }
+  return at;
+}
+
 // UV angle of corner c in the layout x (positive when its face is not flipped).
 double corner_uv_angle(const CutMesh& cut, const Eigen::VectorXd& x, int c) {
   const Eigen::Vector2d p = copy_uv(cut, x, c);
@@ -115,13 +127,7 @@ double fan_angle_ccw(const core::TriMesh& mesh, const CutMesh& cut, const Eigen:
 
 std::vector<FeatureCurve> smooth_feature_curves(const core::TriMesh& mesh, const FeatureSet& fs,
                                                 double max_bend, double corner_length, double corner_turn) {
-  // The features at each vertex, with the other end of their edge.
-  std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());
-  for (int i = 0; i < fs.size(); ++i) {
-    const auto [a, b] = feature_vertices(mesh, fs, i);
-    at[a].push_back({i, b});
-    at[b].push_back({i, a});
-  }
+  const std::vector<std::vector<std::pair<int, int>>> at = features_at_vertices(mesh, fs);
   // partner[i][end]: the feature continuing i at its vertex `end` (0: first, 1: second), or -1.
   std::vector<std::array<int, 2>> partner(fs.size(), {-1, -1});
   for (int v = 0; v < mesh.n_vertices(); ++v) {
@@ -252,12 +258,7 @@ std::vector<FeatureCurve> curves_at_acute_corners(const core::TriMesh& mesh, con
                                                   const std::vector<FeatureCurve>& curves,
                                                   double min_angle, double max_angle,
                                                   double max_bend) {
-  std::vector<std::vector<std::pair<int, int>>> at(mesh.n_vertices());  // (feature, other end)
-  for (int i = 0; i < fs.size(); ++i) {
-    const auto [a, b] = feature_vertices(mesh, fs, i);
-    at[a].push_back({i, b});
-    at[b].push_back({i, a});
-  }
+  const std::vector<std::vector<std::pair<int, int>>> at = features_at_vertices(mesh, fs);
   auto direction = [&](int from, int to) {
     return (Eigen::Vector3d(mesh.V.row(to)) - Eigen::Vector3d(mesh.V.row(from))).normalized();
   };
@@ -270,14 +271,14 @@ std::vector<FeatureCurve> curves_at_acute_corners(const core::TriMesh& mesh, con
   std::vector<FeatureCurve> out;
   for (size_t c = 0; c < curves.size(); ++c) {
     const FeatureCurve& curve = curves[c];
-    if (curve.closed || curve.joints.size() + 1 != curve.features.size()) continue;
-    // The curve's vertices in order: its first end, the joints, its last end.
     const size_t n = curve.features.size();
+    if (curve.closed || n < 2 || curve.joints.size() + 1 != n) continue;
+    // The curve's vertices in order: its first end, the joints, its last end.
     std::vector<int> path(n + 1);
     const auto first = feature_vertices(mesh, fs, curve.features.front());
     const auto last = feature_vertices(mesh, fs, curve.features.back());
-    path.front() = n == 1 ? first[0] : (first[0] == curve.joints.front() ? first[1] : first[0]);
-    path.back() = n == 1 ? first[1] : (last[0] == curve.joints.back() ? last[1] : last[0]);
+    path.front() = first[0] == curve.joints.front() ? first[1] : first[0];
+    path.back() = last[0] == curve.joints.back() ? last[1] : last[0];
     for (size_t k = 0; k + 1 < n; ++k) path[k + 1] = curve.joints[k];
     // Edges [lo, hi) of the curve to take: the straight run from each acute end.
     size_t lo = n, hi = 0;
@@ -285,11 +286,10 @@ std::vector<FeatureCurve> curves_at_acute_corners(const core::TriMesh& mesh, con
       const int v = at_front ? path.front() : path.back();
       const int next = at_front ? path[1] : path[n - 1];
       const Eigen::Vector3d d = direction(v, next);
-      bool acute = false;
-      for (const auto& [j, other] : at[v]) {
-        const double a = angle(d, direction(v, other));
-        if (curve_of[j] != static_cast<int>(c) && a >= min_angle && a < max_angle) acute = true;
-      }
+      const bool acute = std::any_of(at[v].begin(), at[v].end(), [&](const auto& feature) {
+        const double a = angle(d, direction(v, feature.second));
+        return curve_of[feature.first] != static_cast<int>(c) && a >= min_angle && a < max_angle;
+      });
       if (!acute) continue;
       size_t k = 1;  // edges of the run
       while (k < n) {

@@ -244,11 +244,12 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
   if (options.feature_mode == FeatureMode::kDuringRounding) {
     if (options.feature_curve_labels)
       curves = smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length);
-    else if (options.feature_acute_curve_labels && fs.size() > 0)
+    else if (options.feature_acute_curve_labels && fs.size() > 0) {
       curves = curves_at_acute_corners(
           mesh, fs, smooth_feature_curves(mesh, fs, kCurveMaxBend, options.feature_corner_length),
           kAcuteCornerMin, kAcuteCornerMax, kAcuteRunBend);
-    out.stats.n_acute_curves = options.feature_curve_labels ? 0 : static_cast<int>(curves.size());
+      out.stats.n_acute_curves = static_cast<int>(curves.size());
+    }
   }
   out.stats.seconds_cut = seconds_since(t0);
   out.stats.n_seam_edges = static_cast<int>(cut.seams.size());
