@@ -158,6 +158,8 @@ constexpr double kSurfacePairSizeChange = 1.75;
 // irregular vertices 815 → 791 (knot1 18 → 14, dilo 84 → 76, plane_holes 68 → 62), dilo's map
 // 17 → 23 s.
 constexpr int kSurfacePairFailures = 8;
+// Failed sets the second wave of surface pairs (ParamOptions::cone_pair_far_factor) may cost.
+constexpr int kFarPairFailures = 4;
 // Penalty stages of a cancellation's move into its constraints (w = 1e3 … 1e5): a set that needs
 // more is rarely made flip-free by the rest of the ladder, and each failure costs a whole-mesh
 // homotopy (casting: 6 failures took 31 of the 43 s of its map).
@@ -849,46 +851,62 @@ ComponentOutput run_component(const core::TriMesh& mesh, const ParamOptions& opt
       move_failures = kMaxCancellationFailures - kSurfacePairFailures;
       max_size_change = kSurfacePairSizeChange;
       const double surface_tau_bound = kSurfacePairTauGrowth * max_isometric_distortion(domain, x);
-      for (int pass = 0; pass < kConePairPasses && move_failures < kMaxCancellationFailures; ++pass) {
-        std::vector<ConePairCancellation> pairs = find_surface_cone_pairs(
-            mesh, cut, vertex_indices(mesh, cut, x), options.cone_pair_distance, feature_vertices);
-        // A pair that failed on its own in an earlier pass is not tried again (knot1: the same
-        // pair, 111 seams apart, failed in two passes).
-        std::erase_if(pairs, [&](const ConePairCancellation& p) {
-          return std::find(failed_moves.begin(), failed_moves.end(),
-                           std::pair(p.positive_vertex, p.negative_vertex)) != failed_moves.end();
-        });
-        int n = 0;
-        // A set that changes some faces' size too much goes again without the pairs nearest to
-        // those faces (by their cones), until one is kept or none is left.
-        while (!pairs.empty() && move_failures < kMaxCancellationFailures) {
-          n = apply_moves(pairs, 0, pairs.size(), surface_tau_bound);
-          if (n > 0 || oversized_faces.empty()) break;
-          std::vector<char> drop(pairs.size(), 0);
-          for (const int f : oversized_faces) {
-            const Eigen::Vector3d c =
-                (mesh.V.row(mesh.F(f, 0)) + mesh.V.row(mesh.F(f, 1)) + mesh.V.row(mesh.F(f, 2))) / 3;
-            size_t nearest = 0;
-            double best = std::numeric_limits<double>::infinity();
-            for (size_t i = 0; i < pairs.size(); ++i)
-              for (const int v : {pairs[i].positive_vertex, pairs[i].negative_vertex}) {
-                const double d = (Eigen::Vector3d(mesh.V.row(v)) - c).squaredNorm();
-                if (d < best) {
-                  best = d;
-                  nearest = i;
+      // Passes over the pairs within `distance` over the surface; the number of pairs cancelled.
+      auto surface_passes = [&](double distance) {
+        int cancelled = 0;
+        for (int pass = 0; pass < kConePairPasses && move_failures < kMaxCancellationFailures; ++pass) {
+          std::vector<ConePairCancellation> pairs = find_surface_cone_pairs(
+              mesh, cut, vertex_indices(mesh, cut, x), distance, feature_vertices);
+          // A pair that failed on its own in an earlier pass is not tried again (knot1: the same
+          // pair, 111 seams apart, failed in two passes).
+          std::erase_if(pairs, [&](const ConePairCancellation& p) {
+            return std::find(failed_moves.begin(), failed_moves.end(),
+                             std::pair(p.positive_vertex, p.negative_vertex)) != failed_moves.end();
+          });
+          int n = 0;
+          // A set that changes some faces' size too much goes again without the pairs nearest to
+          // those faces (by their cones), until one is kept or none is left.
+          while (!pairs.empty() && move_failures < kMaxCancellationFailures) {
+            n = apply_moves(pairs, 0, pairs.size(), surface_tau_bound);
+            if (n > 0 || oversized_faces.empty()) break;
+            std::vector<char> drop(pairs.size(), 0);
+            for (const int f : oversized_faces) {
+              const Eigen::Vector3d c =
+                  (mesh.V.row(mesh.F(f, 0)) + mesh.V.row(mesh.F(f, 1)) + mesh.V.row(mesh.F(f, 2))) / 3;
+              size_t nearest = 0;
+              double best = std::numeric_limits<double>::infinity();
+              for (size_t i = 0; i < pairs.size(); ++i)
+                for (const int v : {pairs[i].positive_vertex, pairs[i].negative_vertex}) {
+                  const double d = (Eigen::Vector3d(mesh.V.row(v)) - c).squaredNorm();
+                  if (d < best) {
+                    best = d;
+                    nearest = i;
+                  }
                 }
-              }
-            drop[nearest] = 1;
+              drop[nearest] = 1;
+            }
+            std::vector<ConePairCancellation> kept;
+            for (size_t i = 0; i < pairs.size(); ++i)
+              if (!drop[i]) kept.push_back(std::move(pairs[i]));
+            pairs = std::move(kept);
           }
-          std::vector<ConePairCancellation> kept;
-          for (size_t i = 0; i < pairs.size(); ++i)
-            if (!drop[i]) kept.push_back(std::move(pairs[i]));
-          pairs = std::move(kept);
+          cancelled += n;
+          if (n == 0) break;
         }
-        out.stats.n_cancelled_pairs += n;
-        out.stats.n_surface_pairs += n;
-        if (n == 0) break;
+        return cancelled;
+      };
+      const int near = surface_passes(options.cone_pair_distance);
+      // The second wave: pairs farther over the surface, under the same bounds, once the near
+      // ones are gone (taken together from the start, far pairs crowd out near ones whose sets
+      // then fail: see ParamOptions::cone_pair_far_factor).
+      int far = 0;
+      if (options.cone_pair_far_factor > 1) {
+        move_failures = kMaxCancellationFailures - kFarPairFailures;
+        far = surface_passes(options.cone_pair_far_factor * options.cone_pair_distance);
       }
+      out.stats.n_cancelled_pairs += near + far;
+      out.stats.n_surface_pairs += near + far;
+      out.stats.n_far_pairs += far;
       max_size_change = 0;
     }
     out.stats.seconds_optimize += seconds_since(to);
@@ -1107,8 +1125,9 @@ core::Status validate(const core::TriMesh& mesh, const ParamOptions& o) {
   if (o.max_newton_iters < 1) return core::Status::invalid_input("max_newton_iters must be >= 1");
   if (!(o.cone_split_distance >= 0) || o.cone_split_max_index < 1 || o.cone_split_max_index > 2)
     return core::Status::invalid_input("cone_split_distance must be >= 0 and cone_split_max_index 1 or 2");
-  if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1)
-    return core::Status::invalid_input("cone_pair_distance must be >= 0 and cone_pair_max_hops >= 1");
+  if (!(o.cone_pair_distance >= 0) || o.cone_pair_max_hops < 1 || !std::isfinite(o.cone_pair_far_factor))
+    return core::Status::invalid_input(
+        "cone_pair_distance must be >= 0, cone_pair_max_hops >= 1 and cone_pair_far_factor finite");
   if (!(o.cone_scale >= 0) || !std::isfinite(o.cone_scale))
     return core::Status::invalid_input("cone_scale must be finite and >= 0");
   if (!(o.seam_tol > 0)) return core::Status::invalid_input("seam_tol must be positive");
@@ -1383,6 +1402,7 @@ ParamResult compute_seamless_param(const core::TriMesh& mesh, const ParamOptions
     st.n_batches = std::max(st.n_batches, o.stats.n_batches);
     st.n_cancelled_pairs += o.stats.n_cancelled_pairs;
     st.n_surface_pairs += o.stats.n_surface_pairs;
+    st.n_far_pairs += o.stats.n_far_pairs;
     st.n_split_cones += o.stats.n_split_cones;
     st.n_deferred_matchings += o.stats.n_deferred_matchings;
     st.total_iterations += o.stats.total_iterations;

@@ -455,6 +455,8 @@ TEST_F(CliTest, RemeshUsesCoarseConesWhereTheMapHasTooManyCones) {
   const auto seams_only = run("--cone-scale 0 --surface-cone-pairs off");
   EXPECT_EQ(seams_only["param"]["cones"], fine_cones);
   EXPECT_EQ(seams_only["param"]["surface_pairs"], 0);
+  EXPECT_EQ(seams_only["param"]["far_pairs"], 0);
+  EXPECT_LE(plain["param"]["far_pairs"].get<int>(), plain["param"]["surface_pairs"].get<int>());
   std::string bad_args;
   bad_args.append("'").append(spot).append("' -o o.obj --cone-scale sometimes");
   const CliRun bad = quadify(bad_args, dir_);

@@ -96,6 +96,7 @@ int run_param(const ParamArgs& args, const CommonOptions& common) {
                      {"improved", s.n_improved},
                      {"cancelled_pairs", s.n_cancelled_pairs},
                      {"surface_pairs", s.n_surface_pairs},
+                     {"far_pairs", s.n_far_pairs},
                      {"split_cones", s.n_split_cones},
                      {"deferred_matchings", s.n_deferred_matchings},
                      {"coarse_cones", s.coarse_cones},
