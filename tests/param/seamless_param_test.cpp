@@ -214,7 +214,9 @@ TEST(SeamlessParam, ConePairCancellationRemovesClosePairs) {
 
 // Pairs near over the surface (cone_pair_surface): after the seam-path cancellation the map is
 // still flip-free and seamless with Σ index 4χ; every pair removed over the surface removes two
-// cones, and none is left that the seam-path cancellation alone would have removed.
+// cones, and none is left that the seam-path cancellation alone would have removed. The second
+// wave (cone_pair_far_factor) runs after the first one is done: the first wave's cancellations
+// are the same, and each far pair removes two more cones.
 TEST(SeamlessParam, SurfaceConePairsKeepTheMapValid) {
   const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("spot.obj")));
   ParamOptions seams;
@@ -224,37 +226,24 @@ TEST(SeamlessParam, SurfaceConePairsKeepTheMapValid) {
   check_result("spot (seam pairs)", mesh, before);
   ParamOptions surface = seams;
   surface.cone_pair_surface = true;
-  surface.cone_pair_far_factor = 1;  // the first wave only (the second: test below)
+  surface.cone_pair_far_factor = 1;  // the first wave only
   const ParamResult after = compute_seamless_param(mesh, surface);
   const Checked c = check_result("spot (surface pairs)", mesh, after);
   EXPECT_EQ(c.cone_sum, 8) << "Σ cone index must stay 4χ";
   EXPECT_EQ(before.stats.n_surface_pairs, 0);
   EXPECT_GT(after.stats.n_surface_pairs, 0);
+  EXPECT_EQ(after.stats.n_far_pairs, 0);
   EXPECT_EQ(after.stats.n_cancelled_pairs - after.stats.n_surface_pairs, before.stats.n_cancelled_pairs);
   EXPECT_EQ(after.stats.n_cones, before.stats.n_cones - 2 * after.stats.n_surface_pairs);
-}
 
-// The second wave of surface pairs (cone_pair_far_factor): it runs after the first one is done,
-// so the first wave's cancellations are the same, and each far pair removes two more cones; the
-// map stays flip-free and seamless with Σ index 4χ.
-TEST(SeamlessParam, FarSurfaceConePairsComeAfterTheNearOnes) {
-  const core::TriMesh mesh = core::to_trimesh(core::read_mesh(test::data_path("spot.obj")));
-  ParamOptions near;
-  near.cone_pair_distance = 0.3;
-  near.cone_pair_max_hops = 6;
-  near.cone_pair_surface = true;
-  near.cone_pair_far_factor = 1;
-  const ParamResult before = compute_seamless_param(mesh, near);
-  check_result("spot (near surface pairs)", mesh, before);
-  ParamOptions far = near;
+  ParamOptions far = surface;
   far.cone_pair_far_factor = 4;
-  const ParamResult after = compute_seamless_param(mesh, far);
-  const Checked c = check_result("spot (far surface pairs)", mesh, after);
-  EXPECT_EQ(c.cone_sum, 8) << "Σ cone index must stay 4χ";
-  EXPECT_EQ(before.stats.n_far_pairs, 0);
-  EXPECT_GT(after.stats.n_far_pairs, 0);
-  EXPECT_EQ(after.stats.n_surface_pairs - after.stats.n_far_pairs, before.stats.n_surface_pairs);
-  EXPECT_EQ(after.stats.n_cones, before.stats.n_cones - 2 * after.stats.n_far_pairs);
+  const ParamResult after_far = compute_seamless_param(mesh, far);
+  const Checked cf = check_result("spot (far surface pairs)", mesh, after_far);
+  EXPECT_EQ(cf.cone_sum, 8) << "Σ cone index must stay 4χ";
+  EXPECT_GT(after_far.stats.n_far_pairs, 0);
+  EXPECT_EQ(after_far.stats.n_surface_pairs - after_far.stats.n_far_pairs, after.stats.n_surface_pairs);
+  EXPECT_EQ(after_far.stats.n_cones, after.stats.n_cones - 2 * after_far.stats.n_far_pairs);
 }
 
 // Cone splitting: the thin spike's apex gets a cone of index 3 (UV angle π/2, a quad vertex of
